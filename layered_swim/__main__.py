@@ -1,0 +1,5 @@
+import sys
+
+from layered_swim.cli import main
+
+sys.exit(main())

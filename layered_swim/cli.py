@@ -1,0 +1,153 @@
+"""``layered-swim``: headless runs, the stroke list, the drag validation and the step benchmark.
+
+Heavy modules are imported inside the commands: PyBullet must not be loaded before ``main``
+has moved C-level stdout out of the way (see ``_guard_stdout``).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+
+PROG = "layered-swim"
+
+
+def _guard_stdout() -> None:
+    """PyBullet's C code printf's (importer notes; its build time in some builds) into C's stdio
+    buffer, which a piped stdout flushes at exit, after our output: it would corrupt ``--json``.
+    Point fd 1 at /dev/null for C and keep Python's ``sys.stdout`` on a duplicate of the real one."""
+    sys.stdout.flush()
+    real = os.dup(1)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    os.close(devnull)
+    sys.stdout = open(real, "w", buffering=1, closefd=True)
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog=PROG, description="A physically simulated human swimmer.")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    run = sub.add_parser("run", help="swim a stroke headless and write summary, log and config")
+    run.add_argument("--stroke", required=True, help="stroke name (see `strokes`) or path to a stroke .yaml")
+    run.add_argument("--seconds", type=float, default=30.0, help="simulated seconds (default 30)")
+    run.add_argument("--out", help="output folder (default runs/<stroke>-<timestamp>)")
+    run.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    run.add_argument("--lung-volume", type=float, dest="lung_air_l", metavar="L",
+                     help="inhaled air in litres, on top of the residual volume (default 3)")
+    fluid = run.add_mutually_exclusive_group()
+    fluid.add_argument("--density", type=float, metavar="KG_M3", help="water density (fresh water's viscosity)")
+    fluid.add_argument("--fluid", choices=("fresh_water", "seawater"), default="fresh_water")
+    run.add_argument("--seed", type=int, default=0)
+    run.add_argument("--physics-hz", type=int, default=480)
+    run.add_argument("--tempo", type=float, default=1.0, help="stroke rate multiplier (default 1)")
+
+    sub.add_parser("strokes", help="list the available strokes")
+
+    validate = sub.add_parser("validate", help="compare the model with measurements")
+    validate.add_argument("what", choices=("drag",), help="drag: towed passive drag vs Narita et al. 2017")
+    validate.add_argument("--json", action="store_true")
+
+    bench = sub.add_parser("bench", help="time one physics step, bare and through the whole loop")
+    bench.add_argument("--json", action="store_true")
+    bench.add_argument("--seconds", type=float, default=5.0, help="simulated seconds per repeat (default 5)")
+    bench.add_argument("--physics-hz", type=int, default=480)
+    return p
+
+
+def _table(rows: list[list[str]], header: list[str] | None = None) -> str:
+    rows = ([header] if header else []) + rows
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
+
+
+def _fmt(value) -> str:
+    return f"{value:.3f}" if isinstance(value, float) else str(value)
+
+
+def _cmd_run(args) -> None:
+    from layered_swim.runs import default_out_dir, run_swim
+
+    out_dir = args.out or default_out_dir(args.stroke)
+    result = run_swim(args.stroke, args.seconds, args.lung_air_l, args.density, out_dir, args.seed,
+                      args.physics_hz, args.tempo, fluid=args.fluid, progress=not args.json and sys.stderr.isatty())
+    if args.json:
+        print(json.dumps({**result, "out_dir": str(out_dir)}, allow_nan=False))
+        return
+    print(_table([[k, _fmt(v)] for k, v in result.items() if v is not None]))
+    print(f"\nwrote summary.json, config.json, log.npz, timeseries.csv to {out_dir}")
+
+
+def _cmd_strokes(args) -> None:
+    from layered_swim.body.model import load_body
+    from layered_swim.config import ConfigError
+    from layered_swim.control.pose import joint_layout
+    from layered_swim.control.stroke import available_strokes, load_stroke
+
+    layout = joint_layout(load_body())
+    rows = []
+    for name in available_strokes():
+        try:
+            stroke = load_stroke(name, layout)
+        except ConfigError as err:   # one broken file should not hide the others
+            rows.append([name, "-", f"invalid: {err}"])
+            continue
+        first_line = (stroke.description.strip().splitlines() or [""])[0]
+        rows.append([name, f"{60.0 / stroke.period_s:.1f}", first_line])
+    print(_table(rows, ["stroke", "cycles/min", "description"]))
+
+
+def _cmd_validate(args) -> None:
+    from layered_swim.analysis.drag import REFERENCE_PASSIVE_DRAG_N_S2_M2, towed_drag
+    from layered_swim.body.model import load_body
+    from layered_swim.fluid.medium import Medium
+
+    rows = towed_drag(load_body(), Medium())
+    if args.json:
+        print(json.dumps(rows))
+        return
+    print(_table([[f"{r['speed_m_s']:.1f}", f"{r['drag_n']:.1f}", f"{r['reference_n']:.1f}", f"{r['ratio']:.3f}"]
+                  for r in rows],
+                 ["speed m/s", "model drag N", f"reference {REFERENCE_PASSIVE_DRAG_N_S2_M2:g} v^2 N", "ratio"]))
+
+
+def _cmd_bench(args) -> None:
+    from layered_swim.runs import bench_step
+
+    result = bench_step(args.seconds, args.physics_hz)
+    if args.json:
+        print(json.dumps(result))
+        return
+    print(_table([[k, _fmt(v)] for k, v in result.items()]))
+
+
+COMMANDS = {"run": _cmd_run, "strokes": _cmd_strokes, "validate": _cmd_validate, "bench": _cmd_bench}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point. Redirects fd 1 for the rest of the process (see ``_guard_stdout``): call it
+    in a subprocess, not inside a test runner that captures output."""
+    _guard_stdout()
+    args = _parser().parse_args(argv)
+    from layered_swim.config import ConfigError
+    from layered_swim.sim.simulation import SimulationDiverged  # imports PyBullet quietly (sim/world.py)
+
+    try:
+        COMMANDS[args.command](args)
+    except (ConfigError, SimulationDiverged, OSError) as err:
+        print(f"{PROG}: error: {_one_line(err)}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
+    return 0
+
+
+def _one_line(err: Exception) -> str:
+    text = str(err) if not isinstance(err, OSError) or not err.filename else f"{err.filename}: {err.strerror}"
+    return " ".join(text.split())
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,97 @@
+"""Records a simulation at a fixed log rate and writes ``log.npz`` and ``timeseries.csv``.
+
+Pass the recorder as ``sim.run(..., every_step=recorder)``. It is created right after
+``sim.reset()`` and takes the starting state as sample 0; sample k is the state after physics
+step k * (physics_hz / log_hz). The fluid force logged with a state is the one applied during
+the step that led to it; at sample 0 nothing has been applied or commanded yet, so the fluid
+force and the desired pose are NaN there.
+"""
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+
+from layered_swim.analysis.metrics import head_top_height_m
+from layered_swim.config import ConfigError
+
+DEFAULT_LOG_HZ = 60
+# Arrays in the order the hash reads them; names come from the recorder, not the simulation.
+ARRAY_NAMES = ("time_s", "root_pos_m", "root_quat_xyzw", "com_pos_m", "com_vel_m_s", "segment_pos_m",
+               "segment_quat_xyzw", "joint_positions", "desired_pose_rad", "fluid_force_n", "head_top_m")
+CSV_COLUMNS = ("time_s", "pelvis_x_m", "pelvis_y_m", "pelvis_z_m", "com_speed_m_s", "head_top_m")
+
+
+def joint_position_names(layout) -> tuple[str, ...]:
+    """Column names of ``World.joint_positions()``: ball joints as quaternions, hinges as angles."""
+    names = []
+    for is_ball, coord, motor in zip(layout.motor_is_ball, layout.motor_coord, layout.motor_joint):
+        names += [f"{motor}.q{c}" for c in "xyzw"] if is_ball else [layout.names[coord]]
+    return tuple(names)
+
+
+def log_hash(arrays: Mapping[str, np.ndarray]) -> str:
+    """sha256 over name, dtype, shape and raw bytes of every logged array, in a fixed order."""
+    digest = hashlib.sha256()
+    for name in ARRAY_NAMES:
+        a = np.ascontiguousarray(arrays[name])
+        digest.update(f"{name}|{a.dtype.str}|{a.shape}|".encode())
+        digest.update(a.tobytes())
+    return digest.hexdigest()
+
+
+class Recorder:
+    def __init__(self, sim, log_hz: int = DEFAULT_LOG_HZ):
+        physics_hz = sim.config.physics_hz
+        if log_hz <= 0 or physics_hz % log_hz:
+            raise ConfigError(f"log rate {log_hz} Hz must divide the physics rate {physics_hz} Hz")
+        self.every = physics_hz // log_hz
+        self._physics_hz = physics_hz
+        body = sim.body
+        self.segment_names = body.segment_names
+        self.joint_names = joint_position_names(sim.layout)
+        self.pose_names = sim.layout.names
+        self._mass_fraction = body.mass_kg / body.mass_kg.sum()
+        self._head = body.index("head")
+        self._head_half_z_m = float(body.half_extents_m[self._head, 2])
+        self._rows: dict[str, list] = {name: [] for name in ARRAY_NAMES if name != "head_top_m"}
+        self._record(sim, fresh=True)
+
+    def __call__(self, sim) -> None:
+        if sim.steps % self.every == 0:
+            self._record(sim, fresh=False)
+
+    def _record(self, sim, fresh: bool) -> None:
+        s, rows = sim.state, self._rows
+        rows["time_s"].append(sim.steps / self._physics_hz)   # exact, unlike a running sum of dt
+        rows["root_pos_m"].append(s.pos_m[0])
+        rows["root_quat_xyzw"].append(s.quat_xyzw[0])
+        rows["com_pos_m"].append(self._mass_fraction @ s.pos_m)
+        rows["com_vel_m_s"].append(self._mass_fraction @ s.linvel_m_s)
+        rows["segment_pos_m"].append(s.pos_m)
+        rows["segment_quat_xyzw"].append(s.quat_xyzw)
+        rows["joint_positions"].append(sim.world.joint_positions())
+        rows["desired_pose_rad"].append(np.full(len(self.pose_names), np.nan) if fresh else sim.desired_pose.copy())
+        rows["fluid_force_n"].append(np.full_like(s.pos_m, np.nan) if fresh else sim.fluid_force_n.copy())
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        out = {name: np.array(rows, dtype=float) for name, rows in self._rows.items()}
+        out["head_top_m"] = head_top_height_m(out["segment_pos_m"][:, self._head],
+                                              out["segment_quat_xyzw"][:, self._head], self._head_half_z_m)
+        return {name: out[name] for name in ARRAY_NAMES}
+
+    def log_hash(self) -> str:
+        return log_hash(self.arrays())
+
+    def save(self, out_dir: str | Path) -> None:
+        """Write ``log.npz`` (every array plus the name lists) and ``timeseries.csv``."""
+        out_dir = Path(out_dir)
+        a = self.arrays()
+        np.savez_compressed(out_dir / "log.npz", **a, segment_names=np.array(self.segment_names),
+                            joint_names=np.array(self.joint_names), pose_names=np.array(self.pose_names))
+        table = np.column_stack([a["time_s"], a["root_pos_m"], np.linalg.norm(a["com_vel_m_s"], axis=1),
+                                 a["head_top_m"]])
+        np.savetxt(out_dir / "timeseries.csv", table, fmt="%.6f", delimiter=",", header=",".join(CSV_COLUMNS),
+                   comments="")

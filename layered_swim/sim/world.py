@@ -1,0 +1,167 @@
+"""The one place that talks to PyBullet: one client per World, batched reads and writes.
+
+A World owns the swimmer's multibody. Each physics step the simulation loop reads a
+``BodyState`` (per-segment centre-of-mass pose and velocity), applies one external force and
+torque per segment, sets the stable-PD targets and steps.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from layered_swim.body.model import Body
+from layered_swim.body.urdf import write_urdf
+from layered_swim.control.pose import JointLayout
+
+
+@contextlib.contextmanager
+def _pybullet_quiet():
+    """PyBullet prints its build time and importer notes from C onto fds 1 and 2; keep them off a
+    terminal. (A piped stdout buffers them in C until exit: the CLI guards that case itself.)"""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = {fd: os.dup(fd) for fd in (1, 2)}
+    with open(os.devnull, "w") as devnull:
+        for fd in saved:
+            os.dup2(devnull.fileno(), fd)
+        try:
+            yield
+        finally:
+            for fd, copy in saved.items():
+                os.dup2(copy, fd)
+                os.close(copy)
+
+
+with _pybullet_quiet():
+    import pybullet
+    from pybullet_utils.bullet_client import BulletClient
+
+
+@dataclass
+class BodyState:
+    """Per-segment centre-of-mass state, segment order of the Body (root first)."""
+
+    time_s: float
+    pos_m: np.ndarray          # (n, 3)
+    quat_xyzw: np.ndarray      # (n, 4)
+    linvel_m_s: np.ndarray     # (n, 3)
+    angvel_rad_s: np.ndarray   # (n, 3)
+
+
+class World:
+    def __init__(self, body: Body, layout: JointLayout, physics_hz: float, gravity_m_s2: float = 9.81,
+                 pd_gain_scale: dict[str, float] | None = None):
+        self.body = body
+        self.layout = layout
+        self.dt_s = 1.0 / physics_hz
+        self.steps = 0
+        self.gravity_m_s2 = gravity_m_s2
+        with _pybullet_quiet():
+            self.client = BulletClient(connection_mode=pybullet.DIRECT)
+            self.client.setGravity(0, 0, -gravity_m_s2)
+            self.client.setTimeStep(self.dt_s)
+            with tempfile.TemporaryDirectory() as tmp:
+                urdf = write_urdf(body, Path(tmp) / f"{body.name}.urdf")
+                self.uid = self.client.loadURDF(str(urdf), flags=pybullet.URDF_USE_INERTIA_FROM_FILE)
+        c = self.client
+        names = {c.getJointInfo(self.uid, j)[12].decode(): j for j in range(c.getNumJoints(self.uid))}
+        joint_index = {c.getJointInfo(self.uid, j)[1].decode(): j for j in range(c.getNumJoints(self.uid))}
+        self.segment_links = [-1] + [names[s] for s in body.segment_names[1:]]
+        self._child_links = self.segment_links[1:]
+        for link in [-1, *range(c.getNumJoints(self.uid))]:
+            # Open water: no contacts at all (collision shapes exist only for stable PD's sake).
+            c.setCollisionFilterGroupMask(self.uid, link, 0, 0)
+        for j in range(c.getNumJoints(self.uid)):
+            if c.getJointInfo(self.uid, j)[2] == pybullet.JOINT_SPHERICAL:
+                c.setJointMotorControlMultiDof(self.uid, j, pybullet.POSITION_CONTROL, targetPosition=[0, 0, 0, 1],
+                                               targetVelocity=[0, 0, 0], force=[0, 0, 0])
+            else:
+                c.setJointMotorControl2(self.uid, j, pybullet.VELOCITY_CONTROL, force=0)
+
+        self.motor_indices = [joint_index[name] for name in layout.motor_joint]
+        scale = pd_gain_scale or {}
+        kp, kd, force = [], [], []
+        for motor_name, is_ball in zip(layout.motor_joint, layout.motor_is_ball):
+            joint = next(j for j in body.joints if motor_name == j.name or motor_name.startswith(j.name + "_"))
+            s = scale.get(joint.name, 1.0)
+            kp.append(joint.kp * s)
+            kd.append(joint.kd * s)
+            force.append([joint.max_torque_nm] * (3 if is_ball else 1))
+        self._kp, self._kd, self._force = kp, kd, force
+
+    # --- state -------------------------------------------------------------------------
+    def reset(self, root_pos_m, root_quat_xyzw, pose: np.ndarray, root_linvel_m_s=(0.0, 0.0, 0.0)) -> None:
+        c = self.client
+        c.resetBasePositionAndOrientation(self.uid, list(root_pos_m), list(root_quat_xyzw))
+        c.resetBaseVelocity(self.uid, list(root_linvel_m_s), [0.0, 0.0, 0.0])
+        quats = self.layout.ball_quaternions(pose)
+        for m, joint in enumerate(self.motor_indices):
+            if self.layout.motor_is_ball[m]:
+                c.resetJointStateMultiDof(self.uid, joint, list(quats[self.layout.motor_ball[m]]), [0.0, 0.0, 0.0])
+            else:
+                c.resetJointState(self.uid, joint, float(pose[self.layout.motor_coord[m]]), 0.0)
+        self.steps = 0
+
+    @property
+    def time_s(self) -> float:
+        return self.steps * self.dt_s  # a product, not a running sum: no drift over long runs
+
+    def read_state(self) -> BodyState:
+        c = self.client
+        base_pos, base_quat = c.getBasePositionAndOrientation(self.uid)
+        base_lin, base_ang = c.getBaseVelocity(self.uid)
+        links = c.getLinkStates(self.uid, self._child_links, computeLinkVelocity=1, computeForwardKinematics=1)
+        pos = np.array([base_pos] + [s[0] for s in links])
+        quat = np.array([base_quat] + [s[1] for s in links])
+        lin = np.array([base_lin] + [s[6] for s in links])
+        ang = np.array([base_ang] + [s[7] for s in links])
+        return BodyState(self.time_s, pos, quat, lin, ang)
+
+    def joint_positions(self) -> np.ndarray:
+        """Current pose as PyBullet reports it: ball joints as quaternions, hinges as angles,
+        flattened motor by motor."""
+        states = self.client.getJointStatesMultiDof(self.uid, self.motor_indices)
+        return np.concatenate([s[0] for s in states])
+
+    def joint_motor_torques(self) -> np.ndarray:
+        """Torques the stable PD applied on the last step, flattened motor by motor."""
+        states = self.client.getJointStatesMultiDof(self.uid, self.motor_indices)
+        return np.concatenate([s[3] for s in states])
+
+    # --- actions -----------------------------------------------------------------------
+    def apply_wrenches(self, force_n: np.ndarray, torque_nm: np.ndarray, at_m: np.ndarray) -> None:
+        """One force (at each segment's centre of mass ``at_m``) and one torque per segment, world frame."""
+        c, uid, frame = self.client, self.uid, pybullet.WORLD_FRAME
+        for link, f, t, p in zip(self.segment_links, force_n.tolist(), torque_nm.tolist(), at_m.tolist()):
+            c.applyExternalForce(uid, link, f, p, frame)
+            c.applyExternalTorque(uid, link, t, frame)
+
+    def set_targets(self, pose: np.ndarray, rates: np.ndarray) -> None:
+        """Convert a desired pose and its rates into PyBullet's per-motor targets (at control rate)."""
+        layout = self.layout
+        quats, omegas = layout.ball_targets(pose, rates)
+        quats, omegas = quats.tolist(), omegas.tolist()
+        pose_list, rate_list = pose.tolist(), rates.tolist()
+        self._targets = [quats[b] if b >= 0 else [pose_list[k]] for b, k in zip(layout.motor_ball, layout.motor_coord)]
+        self._velocities = [omegas[b] if b >= 0 else [rate_list[k]] for b, k in zip(layout.motor_ball, layout.motor_coord)]
+
+    def drive(self) -> None:
+        """Stable PD toward the last targets. PyBullet computes the torque once per call and holds
+        it, so this must be called before every physics step."""
+        self.client.setJointMotorControlMultiDofArray(
+            self.uid, self.motor_indices, pybullet.STABLE_PD_CONTROL, targetPositions=self._targets,
+            targetVelocities=self._velocities, positionGains=self._kp, velocityGains=self._kd, forces=self._force)
+
+    def step(self) -> None:
+        self.client.stepSimulation()
+        self.steps += 1
+
+    def close(self) -> None:
+        with contextlib.suppress(Exception):
+            self.client.disconnect()

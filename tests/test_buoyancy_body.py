@@ -1,0 +1,28 @@
+"""Yang's floater / sinker transition with the whole body: lung air decides."""
+import numpy as np
+
+from layered_swim.runs import build_swim
+from layered_swim.sim.recorder import Recorder
+
+SECONDS = 6.0
+
+
+def float_rest(lung_air_l: float) -> dict[str, np.ndarray]:
+    sim = build_swim("rest", lung_air_l=lung_air_l).sim
+    recorder = Recorder(sim)
+    try:
+        sim.run(SECONDS, every_step=recorder)
+    finally:
+        sim.close()
+    return recorder.arrays()
+
+
+def test_floater_with_three_litres():
+    log = float_rest(3.0)
+    assert np.abs(log["head_top_m"]).max() < 0.35
+    assert log["root_pos_m"][:, 2].min() > -1.5
+
+
+def test_sinker_with_empty_lungs():
+    log = float_rest(0.0)
+    assert log["root_pos_m"][-1, 2] < -2.0

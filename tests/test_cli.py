@@ -1,0 +1,80 @@
+"""The console script, run as a subprocess the way people run it."""
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+SUMMARY_KEYS = {"stroke", "seconds", "mean_speed_m_s", "stroke_rate_cpm", "distance_per_cycle_m",
+                "peak_shoulder_roll_deg", "mean_head_height_m", "horizontal_drift_m_s",
+                "final_pelvis_depth_m", "note"}
+
+
+def cli(*args, cwd=REPO):
+    env = {**os.environ, "PYTHONPATH": str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    return subprocess.run([sys.executable, "-m", "layered_swim", *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=120)
+
+
+def assert_one_line_error(result, *words):
+    assert result.returncode == 2, result.stderr
+    assert result.stdout == ""
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("layered-swim: error: "), result.stderr
+    for word in words:
+        assert word in lines[0]
+
+
+def test_strokes_lists_rest():
+    result = cli("strokes")
+    assert result.returncode == 0, result.stderr
+    rest = [line for line in result.stdout.splitlines() if line.startswith("rest ")]
+    assert rest and "15.0" in rest[0] and "float" in rest[0]
+
+
+def test_run_json(tmp_path):
+    out = tmp_path / "run"
+    result = cli("run", "--stroke", "rest", "--seconds", "2", "--json", "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert SUMMARY_KEYS <= set(summary)
+    assert summary["stroke"] == "rest" and summary["seconds"] == pytest.approx(2.0)
+    assert "settle" in summary["note"]
+    assert {p.name for p in out.iterdir()} == {"summary.json", "config.json", "log.npz", "timeseries.csv"}
+    config = json.loads((out / "config.json").read_text())
+    assert config["arguments"]["seconds"] == 2.0 and config["stroke"]["name"] == "rest"
+    assert config["medium"]["rho_kg_m3"] > 0 and config["physics_hz"] == 480
+
+
+def test_unknown_stroke(tmp_path):
+    assert_one_line_error(cli("run", "--stroke", "no_such_stroke", "--out", str(tmp_path)), "no_such_stroke")
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--density", "nan"], ["density"]),
+    (["--seconds", "-1"], ["seconds"]),
+    (["--stroke", "missing/stroke.yaml"], ["missing/stroke.yaml"]),
+])
+def test_bad_input(tmp_path, args, words):
+    argv = ["run", "--stroke", "rest", "--out", str(tmp_path / "x"), *args]
+    assert_one_line_error(cli(*argv), *words)
+
+
+def test_malformed_stroke_file(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: bad\nperiod_s: [1, 2\n")
+    assert_one_line_error(cli("run", "--stroke", str(bad), "--out", str(tmp_path / "x")), str(bad))
+
+
+def test_validate_drag_json():
+    result = cli("validate", "drag", "--json")
+    assert result.returncode == 0, result.stderr
+    rows = {row["speed_m_s"]: row for row in json.loads(result.stdout)}
+    for speed in (1.0, 1.5, 2.0):
+        row = rows[speed]
+        assert row["reference_n"] == pytest.approx(23.5 * speed**2)
+        assert 0.8 < row["drag_n"] / row["reference_n"] < 1.2

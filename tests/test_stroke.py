@@ -1,0 +1,92 @@
+"""The basic stroke layer: key interpolation, mirroring, and one-line errors for bad files."""
+import textwrap
+
+import numpy as np
+import pytest
+
+from layered_swim.body.model import load_body
+from layered_swim.config import ConfigError
+from layered_swim.control.pose import joint_layout
+from layered_swim.control.stroke import available_strokes, load_stroke
+
+LAYOUT = joint_layout(load_body())
+KEYS_DEG = {0.0: 10.0, 0.25: 120.0, 0.5: 60.0, 0.75: 100.0}   # on the table grid (1/1024)
+GOOD = textwrap.dedent("""\
+    name: test
+    period_s: 1.5
+    keys:
+      shoulder_l:
+        flexion: {0.0: 10, 0.25: 120, 0.5: 60, 0.75: 100}
+        abduction: {0.1: 20, 0.6: 0}
+      shoulder_r: {mirror_of: shoulder_l, phase_shift: 0.5}
+      elbow_l:
+        flexion: {0.0: 0, 0.5: 145}
+""")
+
+
+def write(tmp_path, text, name="stroke.yaml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture
+def stroke(tmp_path):
+    return load_stroke(str(write(tmp_path, GOOD)), LAYOUT)
+
+
+def test_keys_are_hit(stroke):
+    k = LAYOUT.index("shoulder_l.flexion")
+    for phase, deg in KEYS_DEG.items():
+        assert np.degrees(stroke.pose(phase)[0][k]) == pytest.approx(deg, abs=1e-9)
+
+
+def test_periodic(stroke):
+    for phase in (0.0, 0.3, 0.77):
+        for a, b in zip(stroke.pose(phase), stroke.pose(phase + 1.0)):
+            np.testing.assert_allclose(a, b, atol=1e-12)
+    np.testing.assert_allclose(stroke.table[0], stroke.table[-1])
+
+
+def test_no_overshoot(stroke):
+    deg = np.degrees(stroke.table)
+    k = LAYOUT.index("shoulder_l.flexion")
+    assert deg[:, k].min() >= 10.0 - 1e-9 and deg[:, k].max() <= 120.0 + 1e-9
+    e = LAYOUT.index("elbow_l.flexion")
+    assert deg[:, e].min() >= -1e-9 and deg[:, e].max() <= 145.0 + 1e-9
+
+
+def test_mirror_is_half_a_cycle_later(stroke):
+    for axis in ("flexion", "abduction"):
+        left, right = LAYOUT.index(f"shoulder_l.{axis}"), LAYOUT.index(f"shoulder_r.{axis}")
+        for phase in np.arange(0.0, 1.0, 1 / 64):
+            assert stroke.pose(phase + 0.5)[0][right] == pytest.approx(stroke.pose(phase)[0][left], abs=1e-12)
+
+
+def test_unkeyed_axes_hold_the_rest_pose(stroke):
+    assert np.all(stroke.table[:, LAYOUT.index("knee_l.flexion")] == 0.0)
+
+
+@pytest.mark.parametrize("name", available_strokes())
+def test_shipped_strokes_load(name):
+    s = load_stroke(name, LAYOUT)
+    assert s.period_s > 0
+    assert np.all(s.table >= LAYOUT.lower_rad - 1e-9) and np.all(s.table <= LAYOUT.upper_rad + 1e-9)
+
+
+@pytest.mark.parametrize("text, words", [
+    (GOOD.replace("elbow_l:", "elbow_x:"), ["keys.elbow_x", "unknown joint"]),
+    (GOOD.replace("abduction: {0.1", "twist: {0.1"), ["keys.shoulder_l", "twist"]),
+    (GOOD.replace("0.5: 145", "1.0: 145"), ["keys.elbow_l", "flexion", "[0, 1)"]),
+    (GOOD.replace("0.5: 145", "0.5: 170"), ["keys.elbow_l", "flexion", "range"]),
+    (GOOD.replace("period_s: 1.5\n", ""), ["period_s"]),
+    (GOOD.replace("period_s: 1.5", "period_s: -1"), ["period_s"]),
+    (GOOD.replace("flexion: {0.0: 0, 0.5: 145}", "flexion: {0.0: 0, 0.5: 145"), ["line"]),
+])
+def test_bad_stroke_file(tmp_path, text, words):
+    path = write(tmp_path, text, "bad.yaml")
+    with pytest.raises(ConfigError) as err:
+        load_stroke(str(path), LAYOUT)
+    message = str(err.value)
+    assert "\n" not in message
+    assert str(path) in message and all(word in message for word in words), message
