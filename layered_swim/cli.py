@@ -7,8 +7,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
+import time
+from pathlib import Path
 
 PROG = "layered-swim"
 
@@ -48,6 +51,28 @@ def _parser() -> argparse.ArgumentParser:
     validate = sub.add_parser("validate", help="compare the model with measurements")
     validate.add_argument("what", choices=("drag",), help="drag: towed passive drag vs Narita et al. 2017")
     validate.add_argument("--json", action="store_true")
+
+    calibrate = sub.add_parser("calibrate", help="measure each perturbation sequence's turn per cycle (Yang 4.3)")
+    calibrate.add_argument("--stroke", required=True, help="stroke name or path to a stroke .yaml")
+    calibrate.add_argument("--workers", type=int, default=2, help="parallel simulations (default 2)")
+    calibrate.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+    follow = sub.add_parser("follow", help="chase a target moving along a trajectory file")
+    follow.add_argument("trajectory", help="trajectory name (see trajectories/) or path to a .yaml")
+    follow.add_argument("--stroke", default="breaststroke")
+    follow.add_argument("--layers", default="basic,cycle,rules", help="basic[,cycle][,rules|palm|reach]")
+    follow.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
+    follow.add_argument("--density", type=float, metavar="KG_M3")
+    follow.add_argument("--seconds", type=float, default=60.0)
+    follow.add_argument("--out", help="output folder (default runs/follow-<trajectory>-<timestamp>)")
+    follow.add_argument("--json", action="store_true")
+
+    goal = sub.add_parser("goal", help="SWIM's goal-reaching benchmark (Pos, Prog, Dev, Roll)")
+    goal.add_argument("--pool", choices=("small", "large"), default="small")
+    goal.add_argument("--stroke", default="front_crawl")
+    goal.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
+    goal.add_argument("--layers", default="basic,cycle,rules")
+    goal.add_argument("--json", action="store_true")
 
     bench = sub.add_parser("bench", help="time one physics step, bare and through the whole loop")
     bench.add_argument("--json", action="store_true")
@@ -122,7 +147,65 @@ def _cmd_bench(args) -> None:
     print(_table([[k, _fmt(v)] for k, v in result.items()]))
 
 
-COMMANDS = {"run": _cmd_run, "strokes": _cmd_strokes, "validate": _cmd_validate, "bench": _cmd_bench}
+def _vector(text: str, what: str) -> tuple[float, float, float]:
+    from layered_swim.config import ConfigError
+
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise ConfigError(f"{what} must be three numbers X,Y,Z, got '{text}'")
+    return values
+
+
+def _cmd_calibrate(args) -> None:
+    from layered_swim.body.model import load_body
+    from layered_swim.control.calibration import calibrate, calibration_path, save_table
+    from layered_swim.control.pose import joint_layout
+    from layered_swim.control.stroke import load_stroke
+
+    stroke = load_stroke(args.stroke, joint_layout(load_body()))
+    table = calibrate(stroke, workers=max(1, args.workers), progress=not args.no_progress and sys.stderr.isatty())
+    path = save_table(table, calibration_path(stroke.name))
+    rows = [[name, f"{table.tempos[-1]:g}"] + [f"{math.degrees(v):.1f}" for v in turns[-1]]
+            for name, turns in table.turn_rad.items()]
+    print(_table(rows, ["sequence", "tempo"] + [f"w={w:g}" for w in table.weights]))
+    print(f"\nturn in degrees per cycle; speed at tempo {table.tempos[-1]:g}: {table.speed_m_s[-1]:.2f} m/s; wrote {path}")
+
+
+def _cmd_follow(args) -> None:
+    from layered_swim.control.layered import Layers
+    from layered_swim.tasks import follow_run
+
+    out = args.out or str(Path("runs") / f"follow-{Path(args.trajectory).stem}-{time.strftime('%Y%m%d-%H%M%S')}")
+    result = follow_run(args.trajectory, args.stroke, Layers.parse(args.layers), _vector(args.current, "--current"),
+                        args.density, args.seconds, out)
+    if args.json:
+        print(json.dumps({**result, "out_dir": out}, allow_nan=False))
+        return
+    flat = {k: v for k, v in result.items() if not isinstance(v, dict)}
+    flat.update({f"swim.{k}": v for k, v in result.get("swim_metrics", {}).items() if v is not None})
+    print(_table([[k, _fmt(v)] for k, v in flat.items()]))
+    print(f"\nwrote summary.json, config.json, track.npz, log.npz to {out}")
+
+
+def _cmd_goal(args) -> None:
+    from layered_swim.control.layered import Layers
+    from layered_swim.tasks import goal_run
+
+    result = goal_run(args.pool, args.stroke, _vector(args.current, "--current"), Layers.parse(args.layers))
+    if args.json:
+        print(json.dumps(result, allow_nan=False))
+        return
+    rows = [[f"goal y={g['goal_m'][1]:+.2f}"] + [f"{g[k]:.3f}" for k in ("pos_m", "prog", "dev_m", "roll_deg")]
+            for g in result["goals"]]
+    rows.append(["mean"] + [f"{result[k]:.3f}" for k in ("pos_m", "prog", "dev_m", "roll_deg")])
+    print(_table(rows, ["", "Pos m", "Prog", "Dev m", "Roll deg"]))
+
+
+COMMANDS = {"run": _cmd_run, "strokes": _cmd_strokes, "validate": _cmd_validate, "bench": _cmd_bench,
+            "calibrate": _cmd_calibrate, "follow": _cmd_follow, "goal": _cmd_goal}
 
 
 def main(argv: list[str] | None = None) -> int:

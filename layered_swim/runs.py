@@ -19,7 +19,12 @@ import numpy as np
 from layered_swim.analysis.metrics import summary
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, load
+from layered_swim.control.calibration import load_table
+from layered_swim.control.layered import Layers, LayeredController, WeightPolicy, fixed_weights
+from layered_swim.control.policy import TargetPolicy, TempoControl
 from layered_swim.control.pose import joint_layout
+from layered_swim.control.rules import arm_indices
+from layered_swim.control.targets import Target
 from layered_swim.control.stroke import Stroke, StrokeSpec, available_strokes, build_stroke, stroke_path
 from layered_swim.fluid.medium import Medium, preset
 from layered_swim.sim.recorder import DEFAULT_LOG_HZ, Recorder
@@ -45,8 +50,14 @@ def make_medium(fluid: str = "fresh_water", density_kg_m3: float | None = None) 
 
 
 def build_swim(stroke: str, lung_air_l: float | None = None, medium: Medium | None = None,
-               physics_hz: int = 480, tempo: float = 1.0, seed: int = 0) -> SwimSetup:
-    """Everything a run needs, reset to the stroke's start (posture, depth, speed)."""
+               physics_hz: int = 480, tempo: float = 1.0, seed: int = 0, target: Target | None = None,
+               layers: Layers | None = None, policy: WeightPolicy | None = None,
+               tempo_control: TempoControl | None = None) -> SwimSetup:
+    """Everything a run needs, reset to the stroke's start (posture, depth, speed).
+
+    With neither ``target`` nor ``policy`` the basic stroke swims alone. With a ``target`` the
+    layered controller steers toward it (``layers`` says which layers are on; the per-cycle
+    layer needs the stroke's calibration table); a ``policy`` scripts the per-cycle weights."""
     if not isinstance(seed, int) or seed < 0:
         raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
     body = load_body(lung_air_l=lung_air_l)
@@ -54,12 +65,31 @@ def build_swim(stroke: str, lung_air_l: float | None = None, medium: Medium | No
     path = stroke_path(stroke)
     spec = load(StrokeSpec, path)
     parsed = build_stroke(spec, layout, str(path))
-    controller = StrokeController(parsed, tempo)
+    layered = target is not None or policy is not None
+    layers = layers or Layers()
+    if not layered:
+        controller = StrokeController(parsed, tempo)
+    else:
+        if policy is None:
+            policy = (TargetPolicy(target, load_table(parsed), parsed.start.posture, body.mass_kg / body.mass_kg.sum(),
+                                   tempo=tempo_control or TempoControl())
+                      if layers.cycle else fixed_weights({}, tempo=tempo))
+        controller = LayeredController(parsed, layout, arm_indices(body, layout), policy, layers)
     sim = Simulation(body, controller, medium if medium is not None else Medium(), SimConfig(physics_hz=physics_hz), layout=layout,
                      pd_gain_scale=parsed.pd_gain_scale)
+    if layered:
+        controller.water_velocity = lambda state: sim.fluid.flow_at_swimmer(state.pos_m, state.quat_xyzw, state.linvel_m_s)
+        if target is not None:
+            mass_fraction = body.mass_kg / body.mass_kg.sum()
+            controller.desired_direction = lambda state: _unit(target.position(state.time_s) - mass_fraction @ state.pos_m)
     start = parsed.start
     sim.reset(start.posture, start.depth_m, start.speed_m_s)
     return SwimSetup(parsed, spec, sim, np.random.default_rng(seed))
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    norm = float(np.linalg.norm(v))
+    return v / norm if norm > 1e-9 else np.zeros(3)
 
 
 def package_version() -> str:

@@ -8,6 +8,8 @@ left and right arms alternate in front crawl.
 """
 from __future__ import annotations
 
+import hashlib
+import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -40,6 +42,33 @@ class StartSpec(Strict):
     speed_m_s: float = Field(0.0, ge=0.0, le=3.0)
 
 
+SEQUENCE_NAMES = ("pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right")
+Sequence = Literal["pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right"]
+
+
+class PerturbationSpec(Strict):
+    """Per-joint offsets (degrees) relative to the basic stroke, keyed over the cycle, or the
+    left-right mirror of another sequence (``mirror_of: yaw_left``)."""
+
+    description: str = ""
+    mirror_of: Sequence | None = None
+    phase_shift: float = Field(0.0, ge=-1.0, le=1.0)   # with mirror_of: e.g. 0.5 when arms alternate
+    keys: dict[str, JointKeys] = {}
+
+
+class RuleSpec(Strict):
+    enabled: bool = True
+    gain: float = Field(1.0, ge=0.0, le=100.0)
+    max_deg: float = Field(30.0, gt=0.0, le=90.0)
+
+
+class RulesSpec(Strict):
+    """Continuous-layer rules (Yang 4.4): palm orientation and arm reach."""
+
+    palm: RuleSpec = RuleSpec()
+    reach: RuleSpec = RuleSpec(gain=0.5, max_deg=20.0)
+
+
 class StrokeSpec(Strict):
     name: str
     description: str = ""
@@ -49,6 +78,23 @@ class StrokeSpec(Strict):
     rest_pose: dict[str, dict[str, float]] = {}
     keys: dict[str, JointKeys] = {}
     pd_gain_scale: dict[str, PositiveFloat] = {}
+    perturbations: dict[Sequence, PerturbationSpec] = {}
+    rules: RulesSpec = RulesSpec()
+
+
+@dataclass(frozen=True)
+class CyclicTable:
+    """A pose-sized quantity over one cycle: values and their rate per unit phase."""
+
+    values: np.ndarray       # (TABLE_SAMPLES + 1, n), last row = first
+    rates: np.ndarray
+
+    def at(self, phase: float) -> tuple[np.ndarray, np.ndarray]:
+        x = (phase % 1.0) * TABLE_SAMPLES
+        i = min(int(x), TABLE_SAMPLES - 1)
+        w = x - i
+        return (self.values[i] * (1.0 - w) + self.values[i + 1] * w,
+                self.rates[i] * (1.0 - w) + self.rates[i + 1] * w)
 
 
 @dataclass(frozen=True)
@@ -57,19 +103,20 @@ class Stroke:
     description: str
     period_s: float
     start: StartSpec
-    table: np.ndarray        # (TABLE_SAMPLES + 1, n) pose over one cycle, rad (last row = first)
-    rate_table: np.ndarray   # (TABLE_SAMPLES + 1, n) d pose / d phase, rad per cycle
+    basic: CyclicTable                       # pose over one cycle, rad
+    perturbations: dict[str, CyclicTable]    # offsets over one cycle at weight 1, rad
+    rules: RulesSpec
     pd_gain_scale: dict[str, float]
     source: str
+    spec_sha256: str                         # of the parsed file: calibration tables check it
+
+    @property
+    def table(self) -> np.ndarray:
+        return self.basic.values
 
     def pose(self, phase: float) -> tuple[np.ndarray, np.ndarray]:
         """Pose (rad) and its rate per unit phase at ``phase`` in cycles (any real number)."""
-        x = (phase % 1.0) * TABLE_SAMPLES
-        i = min(int(x), TABLE_SAMPLES - 1)
-        w = x - i
-        pose = self.table[i] * (1.0 - w) + self.table[i + 1] * w
-        rate = self.rate_table[i] * (1.0 - w) + self.rate_table[i + 1] * w
-        return pose, rate
+        return self.basic.at(phase)
 
 
 def _cyclic_curve(keys: dict[float, float], shift: float, smooth: bool, where: str):
@@ -93,25 +140,21 @@ def _cyclic_curve(keys: dict[float, float], shift: float, smooth: bool, where: s
     return value, slope
 
 
-def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
-    joints = {name.split(".")[0] for name in layout.names}
-    n = layout.size
-    rest = np.zeros(n)
-    for joint, axes in spec.rest_pose.items():
-        for axis, deg in axes.items():
-            rest[_coord(layout, joints, joint, axis, f"{source}: field 'rest_pose.{joint}.{axis}'")] = np.radians(deg)
-    table = np.tile(rest, (TABLE_SAMPLES + 1, 1))
+def _keyed_table(keys: dict[str, JointKeys], base: np.ndarray, layout: JointLayout, joints: set[str],
+                 smooth: bool, field: str) -> CyclicTable:
+    """Tabulate per-joint keys over one cycle on top of ``base`` (unkeyed axes keep it)."""
+    table = np.tile(base, (TABLE_SAMPLES + 1, 1))
     rates = np.zeros_like(table)
-    smooth = spec.interpolation == "smooth"
-    for joint, keys in spec.keys.items():
-        where = f"{source}: field 'keys.{joint}"
-        source_keys = keys
-        if keys.mirror_of is not None:
-            if keys.mirror_of not in spec.keys or spec.keys[keys.mirror_of].mirror_of is not None:
-                raise ConfigError(f"{where}': mirror_of '{keys.mirror_of}' must name a keyed joint that is not itself a mirror")
-            if keys.axis_keys():
+    for joint, joint_keys in keys.items():
+        where = f"{field}.{joint}"
+        source_keys = joint_keys
+        if joint_keys.mirror_of is not None:
+            mirrored = keys.get(joint_keys.mirror_of)
+            if mirrored is None or mirrored.mirror_of is not None:
+                raise ConfigError(f"{where}': mirror_of '{joint_keys.mirror_of}' must name a keyed joint that is not itself a mirror")
+            if joint_keys.axis_keys():
                 raise ConfigError(f"{where}': a mirrored joint takes no keys of its own")
-            source_keys = spec.keys[keys.mirror_of]
+            source_keys = mirrored
         for axis, axis_keys in source_keys.axis_keys().items():
             k = _coord(layout, joints, joint, axis, f"{where}.{axis}'")
             if not isinstance(axis_keys, dict) or not axis_keys:
@@ -122,18 +165,62 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
                 raise ConfigError(f"{where}.{axis}': keys and values must be numbers") from None
             if not all(np.isfinite(list(parsed)) & np.isfinite(list(parsed.values()))):
                 raise ConfigError(f"{where}.{axis}': keys and values must be finite numbers")
-            table[:, k], rates[:, k] = _cyclic_curve(parsed, keys.phase_shift, smooth, f"{where}.{axis}'")
-    outside = (table < layout.lower_rad - 1e-9) | (table > layout.upper_rad + 1e-9)
+            table[:, k], rates[:, k] = _cyclic_curve(parsed, joint_keys.phase_shift, smooth, f"{where}.{axis}'")
+    return CyclicTable(table, rates)
+
+
+def _swap_side(joint: str) -> str:
+    for a, b in (("_l", "_r"), ("_r", "_l")):
+        if joint.endswith(a):
+            return joint[: -len(a)] + b
+    return joint
+
+
+def mirrored_keys(keys: dict[str, JointKeys], phase_shift: float = 0.0) -> dict[str, JointKeys]:
+    """Left-right mirror, ``phase_shift`` cycles later: _l and _r joints swap keys (their axes are
+    mirrored already); on midline joints the axes named ``*_left`` change sign."""
+    out = {}
+    for joint, joint_keys in keys.items():
+        midline = _swap_side(joint) == joint
+        axes = {axis: ({t: -v for t, v in values.items()} if midline and axis.endswith("_left") else values)
+                for axis, values in joint_keys.axis_keys().items()}
+        mirror_of = _swap_side(joint_keys.mirror_of) if joint_keys.mirror_of else None
+        shift = (joint_keys.phase_shift + (0.0 if mirror_of else phase_shift)) % 1.0   # a mirror follows its source
+        out[_swap_side(joint)] = JointKeys.model_validate({**axes, "mirror_of": mirror_of, "phase_shift": shift})
+    return out
+
+
+def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
+    joints = {name.split(".")[0] for name in layout.names}
+    rest = np.zeros(layout.size)
+    for joint, axes in spec.rest_pose.items():
+        for axis, deg in axes.items():
+            rest[_coord(layout, joints, joint, axis, f"{source}: field 'rest_pose.{joint}.{axis}'")] = np.radians(deg)
+    smooth = spec.interpolation == "smooth"
+    basic = _keyed_table(spec.keys, rest, layout, joints, smooth, f"{source}: field 'keys")
+    outside = (basic.values < layout.lower_rad - 1e-9) | (basic.values > layout.upper_rad + 1e-9)
     if outside.any():
         k = int(np.argwhere(outside.any(axis=0))[0, 0])
         lo, hi = np.degrees(layout.lower_rad[k]), np.degrees(layout.upper_rad[k])
         raise ConfigError(f"{source}: field 'keys.{layout.names[k]}': angles leave the range of motion "
                           f"[{lo:.0f}, {hi:.0f}] deg")
+    perturbations = {}
+    for name, seq in spec.perturbations.items():
+        field = f"{source}: field 'perturbations.{name}"
+        keys = seq.keys
+        if seq.mirror_of is not None:
+            original = spec.perturbations.get(seq.mirror_of)
+            if original is None or original.mirror_of is not None or seq.keys:
+                raise ConfigError(f"{field}': mirror_of '{seq.mirror_of}' must name a sequence with keys of its "
+                                  f"own, and a mirrored sequence takes none")
+            keys = mirrored_keys(original.keys, seq.phase_shift)
+        perturbations[name] = _keyed_table(keys, np.zeros(layout.size), layout, joints, smooth, f"{field}.keys")
     for joint in spec.pd_gain_scale:
         if joint not in joints:
             raise ConfigError(f"{source}: field 'pd_gain_scale.{joint}': unknown joint")
-    return Stroke(spec.name, spec.description, spec.period_s, spec.start, table, rates,
-                  dict(spec.pd_gain_scale), source)
+    digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json"), sort_keys=True).encode()).hexdigest()
+    return Stroke(spec.name, spec.description, spec.period_s, spec.start, basic, perturbations, spec.rules,
+                  dict(spec.pd_gain_scale), source, digest)
 
 
 def _coord(layout: JointLayout, joints: set[str], joint: str, axis: str, where: str) -> int:

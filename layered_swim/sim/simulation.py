@@ -29,8 +29,11 @@ class SimulationDiverged(RuntimeError):
 
 
 class Controller(Protocol):
-    def desired(self, time_s: float, state: BodyState) -> tuple[np.ndarray, np.ndarray]:
-        """Desired pose (rad) and its rate (rad/s) at ``time_s``."""
+    def desired(self, time_s: float, state: BodyState | None) -> tuple[np.ndarray, np.ndarray]:
+        """Desired pose (rad) and its rate (rad/s) at ``time_s`` (``state`` is None at reset)."""
+
+    def reset(self) -> None:
+        """Forget any state (cycle clock, weights) before a new run."""
 
 
 class StrokeController:
@@ -44,6 +47,9 @@ class StrokeController:
 
     def phase(self, time_s: float) -> float:
         return time_s * self.cycles_per_s
+
+    def reset(self) -> None:
+        """Stateless: the phase is a function of time."""
 
     def desired(self, time_s: float, state: BodyState) -> tuple[np.ndarray, np.ndarray]:
         pose, rate = self.stroke.pose(self.phase(time_s))
@@ -88,6 +94,7 @@ class Simulation:
         yaw = (0.0, 0.0, math.sin(heading_rad / 2), math.cos(heading_rad / 2))
         quat = quat_multiply(np.array(yaw), np.array(base))
         velocity = (speed_m_s * math.cos(heading_rad), speed_m_s * math.sin(heading_rad), 0.0)
+        self.controller.reset()
         pose, _ = self.controller.desired(0.0, None)  # the stroke's pose at phase 0 needs no state
         self.world.reset((*position_xy_m, -depth_m), quat, pose, velocity)
         self.steps = 0

@@ -1,0 +1,126 @@
+"""The layered controller (Yang section 4): basic stroke + per-cycle perturbations + rules.
+
+At the start of every stroke cycle a weight policy picks one weight per perturbation sequence
+(and the cycle's tempo); the weights scale and blend the sequences' offsets into the basic pose
+for that whole cycle. Every control step the continuous rules adjust the blended pose from the
+water flowing past the hands. Layers can be switched off one by one (``Layers``).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable, Protocol
+
+import numpy as np
+
+from layered_swim.control.pose import JointLayout, quat_rotate
+from layered_swim.control.rules import ArmIndices, rule_offsets
+from layered_swim.control.steering import LATERAL_LOCAL
+from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
+from layered_swim.sim.world import BodyState
+
+
+@dataclass(frozen=True)
+class Layers:
+    cycle: bool = True
+    palm: bool = True
+    reach: bool = True
+
+    @classmethod
+    def parse(cls, text: str) -> "Layers":
+        """``basic``, ``basic,cycle``, ``basic,cycle,rules`` or with ``palm``/``reach`` alone."""
+        from layered_swim.config import ConfigError
+
+        names = {n.strip() for n in text.split(",") if n.strip()}
+        unknown = names - {"basic", "cycle", "rules", "palm", "reach"}
+        if unknown or "basic" not in names:
+            raise ConfigError(f"--layers must list 'basic' plus any of cycle, rules, palm, reach; got '{text}'")
+        rules = "rules" in names
+        return cls(cycle="cycle" in names, palm=rules or "palm" in names, reach=rules or "reach" in names)
+
+    def describe(self) -> str:
+        parts = ["basic"] + (["cycle"] if self.cycle else [])
+        parts += ["rules"] if self.palm and self.reach else (["palm"] if self.palm else []) + (["reach"] if self.reach else [])
+        return ",".join(parts)
+
+
+@dataclass
+class CycleChoice:
+    """What the per-cycle layer decided at the start of a cycle."""
+
+    weights: dict[str, float] = field(default_factory=dict)
+    tempo: float = 1.0
+
+
+class WeightPolicy(Protocol):
+    def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float) -> CycleChoice: ...
+
+
+class LayeredController:
+    def __init__(self, stroke: Stroke, layout: JointLayout, arms: list[ArmIndices], policy: WeightPolicy,
+                 layers: Layers = Layers(), water_velocity: Callable[[BodyState], np.ndarray] | None = None,
+                 desired_direction: Callable[[BodyState], np.ndarray] | None = None):
+        self.stroke, self.layout, self.arms, self.policy, self.layers = stroke, layout, arms, policy, layers
+        self.water_velocity = water_velocity
+        self.desired_direction = desired_direction
+        self.reset()
+
+    def reset(self) -> None:
+        self.choice = CycleChoice()
+        self.cycle = -1
+        self.cycle_start_s = 0.0
+        self._roll_sum = 0.0
+        self._roll_n = 0
+        self.last_mean_roll_rad = 0.0
+
+    @property
+    def cycles_per_s(self) -> float:
+        return self.choice.tempo / self.stroke.period_s
+
+    def phase(self, time_s: float) -> float:
+        return self.cycle + (time_s - self.cycle_start_s) * self.cycles_per_s
+
+    def _start_cycle(self, time_s: float, state: BodyState | None) -> None:
+        if self.cycle >= 0:
+            self.cycle_start_s += 1.0 / self.cycles_per_s
+        self.cycle += 1
+        self.last_mean_roll_rad = self._roll_sum / self._roll_n if self._roll_n else 0.0
+        self._roll_sum, self._roll_n = 0.0, 0
+        if state is not None:
+            self.choice = self.policy(self.cycle, state, self.last_mean_roll_rad)
+            if not self.layers.cycle:
+                self.choice = CycleChoice(tempo=self.choice.tempo)
+
+    def desired(self, time_s: float, state: BodyState | None) -> tuple[np.ndarray, np.ndarray]:
+        while self.cycle < 0 or (time_s - self.cycle_start_s) * self.cycles_per_s >= 1.0:
+            self._start_cycle(time_s, state)
+        phase = self.phase(time_s)
+        pose, rate = self.stroke.pose(phase)
+        for name, weight in self.choice.weights.items():
+            if weight:
+                offset, offset_rate = self.stroke.perturbations[name].at(phase)
+                pose = pose + weight * offset
+                rate = rate + weight * offset_rate
+        if state is not None:
+            self._track_roll(state)
+            if (self.layers.palm or self.layers.reach) and self.water_velocity is not None:
+                pose = pose + rule_offsets(self.arms, self.stroke.rules, state.quat_xyzw, state.linvel_m_s,
+                                           self.water_velocity(state), self.desired_direction(state),
+                                           self.layout.size, self.layers.palm, self.layers.reach)
+        return self.layout.clamp(pose), rate * self.cycles_per_s
+
+    def _track_roll(self, state: BodyState) -> None:
+        lateral_z = quat_rotate(state.quat_xyzw[2], LATERAL_LOCAL)[2]
+        self._roll_sum += math.asin(max(-1.0, min(1.0, float(lateral_z))))
+        self._roll_n += 1
+
+
+def fixed_weights(weights: dict[str, float], from_cycle: int = 0, tempo: float = 1.0) -> WeightPolicy:
+    """A scripted policy: ``weights`` from cycle ``from_cycle`` on (calibration, experiments)."""
+    unknown = set(weights) - set(SEQUENCE_NAMES)
+    if unknown:
+        raise ValueError(f"unknown perturbation sequences {sorted(unknown)}")
+
+    def policy(cycle: int, state: BodyState, mean_roll_rad: float) -> CycleChoice:
+        return CycleChoice(dict(weights) if cycle >= from_cycle else {}, tempo)
+    return policy

@@ -1,0 +1,60 @@
+"""Where the swimmer points and how far it must turn: the inputs of the per-cycle layer.
+
+All angles in radians. Heading is the yaw of the swimmer's forward axis (the pelvis long axis
+for prone strokes, its front for upright ones); pitch is that axis's elevation; roll is the tilt
+of the shoulder line (thorax lateral axis) out of the horizontal, positive when the left shoulder
+is up. Pure functions of arrays.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from layered_swim.control.pose import quat_rotate
+
+FORWARD_LOCAL = {"prone": np.array([0.0, 0.0, 1.0]), "upright": np.array([1.0, 0.0, 0.0])}
+LATERAL_LOCAL = np.array([0.0, 1.0, 0.0])
+
+
+def wrap_angle(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+@dataclass(frozen=True)
+class Attitude:
+    heading_rad: float
+    pitch_rad: float
+    roll_rad: float
+
+
+def attitude(pelvis_quat: np.ndarray, thorax_quat: np.ndarray, posture: str) -> Attitude:
+    forward = quat_rotate(np.asarray(pelvis_quat, float), FORWARD_LOCAL[posture])
+    lateral = quat_rotate(np.asarray(thorax_quat, float), LATERAL_LOCAL)
+    return Attitude(math.atan2(forward[1], forward[0]), math.asin(max(-1.0, min(1.0, forward[2]))),
+                    math.asin(max(-1.0, min(1.0, lateral[2]))))
+
+
+@dataclass(frozen=True)
+class SteeringGains:
+    """How much of the error the layer tries to remove in one cycle, and pitch limits."""
+
+    yaw_fraction: float = 0.7
+    pitch_fraction: float = 0.5
+    roll_fraction: float = 0.5
+    max_glide_pitch_rad: float = math.radians(30.0)
+
+
+def wanted_turns(att: Attitude, mean_roll_rad: float, position_m: np.ndarray, target_m: np.ndarray,
+                 posture: str, gains: SteeringGains = SteeringGains()) -> dict[str, float]:
+    """Signed turns wanted this cycle: yaw (+ left), pitch (+ nose up), roll (+ toward the left,
+    i.e. left shoulder down)."""
+    delta = np.asarray(target_m, float) - np.asarray(position_m, float)
+    horizontal = math.hypot(delta[0], delta[1])
+    yaw_error = wrap_angle(math.atan2(delta[1], delta[0]) - att.heading_rad) if horizontal > 1e-6 else 0.0
+    turns = {"yaw": gains.yaw_fraction * yaw_error, "pitch": 0.0, "roll": gains.roll_fraction * mean_roll_rad}
+    if posture == "prone":
+        glide = max(-gains.max_glide_pitch_rad, min(gains.max_glide_pitch_rad, math.atan2(delta[2], horizontal)))
+        turns["pitch"] = gains.pitch_fraction * (glide - att.pitch_rad)
+    return turns

@@ -1,0 +1,277 @@
+"""Targets for the swimmer to follow (Yang et al. 2004, section 5): a 3-D point that may move.
+
+A target is fixed, set by the app's mouse (``MovableTarget``), or read from a trajectory file in
+``trajectories/``. Trajectory files describe either a horizontal parametric curve (figure eight,
+circle, sinusoid, line) travelled at a constant speed at a constant depth, or a polyline of timed
+3-D waypoints. Either way the file is turned once into a table of points against a parameter
+(arc length in metres for curves, time in seconds for polylines), so ``position()`` is a binary
+search and a linear blend.
+
+World frame: z up, water surface at z = 0, a depth d is z = -d; the swimmer starts at the origin
+heading +x. Angles in files are degrees measured counterclockwise from +x (seen from above).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Literal, Protocol, runtime_checkable
+
+import numpy as np
+from pydantic import Field, NonNegativeFloat, PositiveFloat
+
+from layered_swim.config import ConfigError, Strict, load_yaml, parse
+
+TRAJECTORIES_DIR = Path(__file__).resolve().parents[2] / "trajectories"
+CURVE_SAMPLES = 4096          # samples per closed curve (figure eight, circle)
+MAX_SAMPLES = 200_000
+
+
+@runtime_checkable
+class Target(Protocol):
+    def position(self, time_s: float) -> np.ndarray:
+        """World position (3,) in metres at ``time_s`` seconds after the start."""
+        ...
+
+    def path_points(self, n: int = 400) -> np.ndarray:
+        """(n, 3) points along the whole path, for drawing; (1, 3) for a point target."""
+        ...
+
+
+def _point(point: Any) -> np.ndarray:
+    p = np.array(point, dtype=float).reshape(-1)
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ValueError(f"a target point must be 3 finite numbers, got {point!r}")
+    return p
+
+
+class FixedTarget:
+    def __init__(self, point: Any):
+        self._point = _point(point)
+
+    def position(self, time_s: float) -> np.ndarray:
+        return self._point.copy()
+
+    def path_points(self, n: int = 400) -> np.ndarray:
+        return self._point[None, :].copy()
+
+
+class MovableTarget(FixedTarget):
+    """A point the app moves (with the mouse); ``position`` returns the last point set."""
+
+    def set(self, point: Any) -> None:
+        self._point = _point(point)
+
+
+class TrajectoryTarget:
+    """A point moving along a table ``points`` (N, 3) sampled at increasing parameter ``u`` (N,).
+
+    The parameter advances at ``rate`` per second (the speed in m/s for curves, where ``u`` is
+    arc length; 1 for polylines, where ``u`` is time), starting ``start_s`` seconds along. With
+    ``loop`` it wraps from the end of the table to its start, otherwise it stops at the end.
+    """
+
+    def __init__(self, points: np.ndarray, u: np.ndarray, rate: float, loop: bool, start_s: float = 0.0,
+                 name: str = "", description: str = "", kind: str = "", spec: Strict | None = None,
+                 source: str = ""):
+        keep = np.concatenate([[True], np.diff(u) > 0])        # drop zero-length steps
+        self._points, self._u = np.asarray(points, float)[keep], np.asarray(u, float)[keep]
+        if len(self._u) < 2:
+            raise ValueError("a trajectory needs at least two distinct samples")
+        self._steps = np.diff(self._points, axis=0)
+        self._du = np.diff(self._u)
+        self._rate, self._period = float(rate), float(self._u[-1])
+        self.loop, self.start_s = loop, float(start_s)
+        self.name, self.description, self.kind, self.spec, self.source = name, description, kind, spec, source
+
+    @property
+    def duration_s(self) -> float:
+        """Seconds for one pass along the whole path (one lap when looping)."""
+        return self._period / self._rate
+
+    @property
+    def length_m(self) -> float:
+        return float(np.linalg.norm(self._steps, axis=1).sum())
+
+    def position(self, time_s: float) -> np.ndarray:
+        u = self._rate * (time_s + self.start_s)
+        u = u % self._period if self.loop else min(max(u, 0.0), self._period)
+        i = min(max(int(np.searchsorted(self._u, u, side="right")) - 1, 0), len(self._du) - 1)
+        return self._points[i] + ((u - self._u[i]) / self._du[i]) * self._steps[i]
+
+    def path_points(self, n: int = 400) -> np.ndarray:
+        u = np.linspace(0.0, self._period, max(int(n), 2))
+        return np.stack([np.interp(u, self._u, self._points[:, k]) for k in range(3)], axis=1)
+
+
+# ---------------------------------------------------------------- file schemas
+
+class Point2(Strict):
+    x: float
+    y: float
+
+
+class Size2(Strict):
+    x: PositiveFloat       # total width along x, m
+    y: PositiveFloat       # total height along y, m
+
+
+class Waypoint(Strict):
+    t_s: NonNegativeFloat
+    x: float
+    y: float
+    z: float               # height above the surface: a depth d is z = -d
+
+
+class _Common(Strict):
+    name: str
+    description: str = ""
+    loop: bool = False
+    start_s: NonNegativeFloat = 0.0     # seconds along the path at time 0
+
+
+class _Curve(_Common):
+    speed_m_s: PositiveFloat
+    depth_m: NonNegativeFloat           # the whole curve lies at z = -depth_m
+
+
+class FigureEightSpec(_Curve):
+    """Lemniscate of Gerono: x = cx + w/2 sin p, y = cy + h/2 sin 2p. It starts at the crossing
+    (the centre) heading into the +x lobe towards +y."""
+    type: Literal["figure_eight"]
+    size_m: Size2
+    center_m: Point2
+
+
+class CircleSpec(_Curve):
+    type: Literal["circle"]
+    radius_m: PositiveFloat
+    center_m: Point2
+    counterclockwise: bool = True
+    start_angle_deg: float = -90.0      # where on the circle it starts, seen from the centre
+
+
+class SinusoidSpec(_Curve):
+    type: Literal["sinusoid"]
+    start_m: Point2
+    heading_deg: float
+    length_m: PositiveFloat             # along the heading
+    amplitude_m: NonNegativeFloat       # to the left of the heading first
+    wavelength_m: PositiveFloat
+
+
+class LineSpec(_Curve):
+    type: Literal["line"]
+    start_m: Point2
+    heading_deg: float
+    length_m: PositiveFloat
+
+
+class PolylineSpec(_Common):
+    """Timed 3-D waypoints, linear in time between them; the first is at t_s = 0. With ``loop``
+    the target returns from the last waypoint to the first over ``closing_s`` seconds."""
+    type: Literal["polyline"]
+    waypoints: list[Waypoint] = Field(min_length=2)
+    closing_s: PositiveFloat | None = None
+
+
+SPECS: dict[str, type[Strict]] = {
+    "figure_eight": FigureEightSpec, "circle": CircleSpec, "sinusoid": SinusoidSpec,
+    "line": LineSpec, "polyline": PolylineSpec,
+}
+
+
+# ---------------------------------------------------------------- building
+
+def _direction(heading_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    a = np.radians(heading_deg)
+    return np.array([np.cos(a), np.sin(a)]), np.array([-np.sin(a), np.cos(a)])
+
+
+def _curve_xy(spec: _Curve) -> np.ndarray:
+    """Dense (N, 2) horizontal samples of a parametric curve, in travel order."""
+    if isinstance(spec, FigureEightSpec):
+        p = np.linspace(0.0, 2 * np.pi, CURVE_SAMPLES + 1)
+        return np.stack([spec.center_m.x + spec.size_m.x / 2 * np.sin(p),
+                         spec.center_m.y + spec.size_m.y / 2 * np.sin(2 * p)], axis=1)
+    if isinstance(spec, CircleSpec):
+        sign = 1.0 if spec.counterclockwise else -1.0
+        a = np.radians(spec.start_angle_deg) + sign * np.linspace(0.0, 2 * np.pi, CURVE_SAMPLES + 1)
+        return np.stack([spec.center_m.x + spec.radius_m * np.cos(a),
+                         spec.center_m.y + spec.radius_m * np.sin(a)], axis=1)
+    start = np.array([spec.start_m.x, spec.start_m.y])
+    forward, left = _direction(spec.heading_deg)
+    if isinstance(spec, LineSpec):
+        return start + np.outer([0.0, spec.length_m], forward)
+    n = int(np.clip(512 * spec.length_m / spec.wavelength_m, 1024, MAX_SAMPLES))
+    s = np.linspace(0.0, spec.length_m, n + 1)
+    lateral = spec.amplitude_m * np.sin(2 * np.pi * s / spec.wavelength_m)
+    return start + np.outer(s, forward) + np.outer(lateral, left)
+
+
+def _check_polyline(spec: PolylineSpec, source: str) -> None:
+    times = [w.t_s for w in spec.waypoints]
+    if times[0] != 0.0:
+        raise ConfigError(f"{source}: field 'waypoints.0.t_s': the first waypoint must be at t_s 0")
+    for i in range(1, len(times)):
+        if times[i] <= times[i - 1]:
+            raise ConfigError(f"{source}: field 'waypoints.{i}.t_s': times must increase "
+                              f"({times[i]:g} after {times[i - 1]:g})")
+    for i, w in enumerate(spec.waypoints):
+        if w.z > 0.0:
+            raise ConfigError(f"{source}: field 'waypoints.{i}.z': z is height above the surface "
+                              f"(z = -depth) and must be <= 0, got {w.z:g}")
+    if spec.loop and spec.closing_s is None:
+        raise ConfigError(f"{source}: field 'closing_s': required when loop is true "
+                          "(seconds from the last waypoint back to the first)")
+    if not spec.loop and spec.closing_s is not None:
+        raise ConfigError(f"{source}: field 'closing_s': only used when loop is true")
+
+
+def build_trajectory(spec: Strict, source: str = "") -> TrajectoryTarget:
+    common = dict(loop=spec.loop, start_s=spec.start_s, name=spec.name, description=spec.description,
+                  kind=spec.type, spec=spec, source=source)
+    if isinstance(spec, PolylineSpec):
+        _check_polyline(spec, source)
+        points = np.array([[w.x, w.y, w.z] for w in spec.waypoints])
+        times = np.array([w.t_s for w in spec.waypoints])
+        if spec.loop:
+            points = np.vstack([points, points[:1]])
+            times = np.append(times, times[-1] + spec.closing_s)
+        return TrajectoryTarget(points, times, 1.0, **common)
+    xy = _curve_xy(spec)
+    points = np.column_stack([xy, np.full(len(xy), -spec.depth_m)])
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    return TrajectoryTarget(points, arc, spec.speed_m_s, **common)
+
+
+def parse_trajectory(data: Any, source: str | Path) -> Strict:
+    """Validate a trajectory file's content; the ``type`` field picks the schema."""
+    known = ", ".join(sorted(SPECS))
+    if not isinstance(data, dict):
+        raise ConfigError(f"{source}: expected a mapping at the top level, got {type(data).__name__}")
+    if "type" not in data:
+        raise ConfigError(f"{source}: field 'type': missing (known: {known})")
+    kind = data["type"]
+    if not isinstance(kind, str) or kind not in SPECS:
+        raise ConfigError(f"{source}: field 'type': unknown trajectory type {kind!r} (known: {known})")
+    return parse(SPECS[kind], data, source)
+
+
+def available_trajectories(directory: Path = TRAJECTORIES_DIR) -> list[str]:
+    return sorted(p.stem for p in directory.glob("*.yaml"))
+
+
+def trajectory_path(name_or_path: str | Path, directory: Path = TRAJECTORIES_DIR) -> Path:
+    candidate = Path(name_or_path)
+    if candidate.suffix in (".yaml", ".yml"):
+        return candidate
+    path = directory / f"{name_or_path}.yaml"
+    if not path.exists():
+        raise ConfigError(f"unknown trajectory '{name_or_path}' "
+                          f"(available: {', '.join(available_trajectories(directory))})")
+    return path
+
+
+def load_trajectory(name_or_path: str | Path, directory: Path = TRAJECTORIES_DIR) -> TrajectoryTarget:
+    """A trajectory by bare name (``figure_eight``) or by path to a YAML file."""
+    path = trajectory_path(name_or_path, directory)
+    return build_trajectory(parse_trajectory(load_yaml(path), path), str(path))

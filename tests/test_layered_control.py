@@ -1,0 +1,141 @@
+"""The per-cycle layer (weights, blending, calibration inversion), the rules and a short follow."""
+import math
+
+import numpy as np
+import pytest
+
+from layered_swim.body.model import load_body
+from layered_swim.config import ConfigError
+from layered_swim.control.calibration import CalibrationTable, load_table
+from layered_swim.control.layered import Layers, LayeredController, fixed_weights
+from layered_swim.control.pose import joint_layout, quat_multiply
+from layered_swim.control.rules import arm_indices, rule_offsets
+from layered_swim.control.steering import Attitude, wanted_turns
+from layered_swim.control.stroke import JointKeys, RulesSpec, StrokeSpec, build_stroke, load_stroke, mirrored_keys
+from layered_swim.control.targets import FixedTarget
+from layered_swim.runs import build_swim
+from layered_swim.sim.simulation import PRONE_QUAT_XYZW
+from layered_swim.sim.world import BodyState
+
+BODY = load_body()
+LAYOUT = joint_layout(BODY)
+
+
+def table(yaw_turns_deg=(0.0, 2.0, 4.0, 6.0, 8.0)) -> CalibrationTable:
+    turns = np.radians([yaw_turns_deg])
+    return CalibrationTable("t", "x", (0.0, 0.25, 0.5, 0.75, 1.0), (1.0,), (0.8,),
+                            {"yaw_left": turns, "yaw_right": turns / 2})
+
+
+def test_table_inversion():
+    t = table()
+    assert t.weight_for("yaw_left", math.radians(3.0), 1.0) == pytest.approx(0.375)
+    assert t.weight_for("yaw_left", math.radians(20.0), 1.0) == 1.0      # capped at the grid's end
+    assert t.weight_for("yaw_left", 0.0, 1.0) == 0.0
+    # A dip in the measured turns is read as saturation, never as a smaller weight.
+    dip = table((0.0, 2.0, 5.0, 4.0, 6.0))
+    assert dip.weight_for("yaw_left", math.radians(5.0), 1.0) == pytest.approx(0.5)
+
+
+def test_weights_pick_the_sequence_that_turns_the_right_way():
+    t = table()
+    left = t.weights_for({"yaw": math.radians(4.0)}, 1.0)
+    assert left == {"yaw_left": pytest.approx(0.5)}
+    right = t.weights_for({"yaw": -math.radians(2.0)}, 1.0)
+    assert right == {"yaw_right": pytest.approx(0.5)}
+
+
+def test_wanted_turns_from_target_position():
+    facing_x = Attitude(heading_rad=0.0, pitch_rad=0.0, roll_rad=0.0)
+    turns = wanted_turns(facing_x, 0.0, np.zeros(3), np.array([0.0, 5.0, 0.0]), "prone")
+    assert turns["yaw"] > 0                      # target on the left: turn left
+    assert wanted_turns(facing_x, 0.0, np.zeros(3), np.array([0.0, -5.0, 0.0]), "prone")["yaw"] < 0
+    deeper = wanted_turns(facing_x, 0.0, np.zeros(3), np.array([3.0, 0.0, -3.0]), "prone")
+    assert deeper["pitch"] < 0                   # target below: nose down
+    assert wanted_turns(facing_x, 0.1, np.zeros(3), np.array([5.0, 0, 0]), "prone")["roll"] > 0  # left up: roll left
+
+
+def test_layers_parse():
+    assert Layers.parse("basic") == Layers(cycle=False, palm=False, reach=False)
+    assert Layers.parse("basic,cycle,rules") == Layers()
+    assert Layers.parse("basic,palm").describe() == "basic,palm"
+    with pytest.raises(ConfigError):
+        Layers.parse("cycle")
+
+
+def test_mirror_swaps_sides_and_flips_left_axes():
+    keys = {"shoulder_l": JointKeys.model_validate({"abduction": {0.0: 10.0}}),
+            "neck": JointKeys.model_validate({"rotation_left": {0.0: 20.0}, "flexion": {0.0: 5.0}})}
+    mirrored = mirrored_keys(keys, phase_shift=0.5)
+    assert mirrored["shoulder_r"].axis_keys() == {"abduction": {0.0: 10.0}}
+    assert mirrored["neck"].axis_keys() == {"rotation_left": {0.0: -20.0}, "flexion": {0.0: 5.0}}
+    assert mirrored["shoulder_r"].phase_shift == 0.5
+
+
+def test_blending_adds_weighted_offsets_for_the_whole_cycle():
+    stroke = load_stroke("breaststroke", LAYOUT)
+    controller = LayeredController(stroke, LAYOUT, arm_indices(BODY, LAYOUT), fixed_weights({"yaw_left": 0.5}),
+                                   Layers(cycle=True, palm=False, reach=False))
+    controller.reset()
+    state = BodyState(0.0, np.zeros((16, 3)), np.tile(PRONE_QUAT_XYZW, (16, 1)), np.zeros((16, 3)), np.zeros((16, 3)))
+    controller.desired(0.0, None)
+    pose, _ = controller.desired(0.3 * stroke.period_s, state)   # cycle 0: no weights yet
+    basic, _ = stroke.pose(0.3)
+    np.testing.assert_allclose(pose, LAYOUT.clamp(basic))
+    t = (1.3) * stroke.period_s                                   # cycle 1: weights chosen at its start
+    state.time_s = t
+    pose, _ = controller.desired(t, state)
+    offset, _ = stroke.perturbations["yaw_left"].at(1.3)
+    np.testing.assert_allclose(pose, LAYOUT.clamp(basic + 0.5 * offset))
+    assert controller.choice.weights == {"yaw_left": 0.5}
+
+
+def _facing_change(arm, offsets, quat, flow_dir):
+    """First-order change of |palm normal . flow| when the palm offsets are applied."""
+    from layered_swim.control.pose import quat_rotate
+
+    normal = quat_rotate(quat[arm.hand], np.array([0.0, 1.0, 0.0]))
+    axes = np.vstack([quat_rotate(quat[arm.forearm], arm.wrist_axes),
+                      quat_rotate(quat[arm.upper_arm], arm.shoulder_rotation_axis)[None]])
+    facing = normal @ flow_dir
+    return np.sign(facing or 1.0) * float(offsets[list(arm.palm_coords)] @ (np.cross(axes, normal) @ flow_dir))
+
+
+@pytest.mark.parametrize("hand_velocity", [[-1.0, 0.0, 0.3], [-1.0, -0.5, 0.3]])
+def test_palm_rule_faces_a_helpful_flow_and_slices_a_hindering_one(hand_velocity):
+    arms = arm_indices(BODY, LAYOUT)
+    quat = np.tile(PRONE_QUAT_XYZW, (16, 1))
+    arm = arms[0]
+    velocity = np.zeros((16, 3))
+    velocity[arm.hand] = hand_velocity          # the hand sweeps back: the water flows past it toward +x
+    flow_dir = -velocity[arm.hand] / np.linalg.norm(velocity[arm.hand])
+    helpful = rule_offsets(arms, RulesSpec(), quat, velocity, np.zeros(3), np.array([1.0, 0.0, 0.0]), LAYOUT.size)
+    assert _facing_change(arm, helpful, quat, flow_dir) > 0          # palm turns into the flow
+    assert helpful[arm.elbow_coord] < 0                              # and the arm reaches further
+    hindering = rule_offsets(arms, RulesSpec(), quat, velocity, np.zeros(3), np.array([-1.0, 0.0, 0.0]), LAYOUT.size)
+    assert _facing_change(arm, hindering, quat, flow_dir) <= 0       # palm slices (stays edge-on)
+    assert hindering[arm.elbow_coord] > 0                            # and the arm stays closer
+
+
+def test_missing_or_stale_calibration_is_a_clear_error(tmp_path):
+    stroke = load_stroke("breaststroke", LAYOUT)
+    with pytest.raises(ConfigError, match="calibrate --stroke breaststroke"):
+        load_table(stroke, directory=tmp_path)
+    (tmp_path / "breaststroke.yaml").write_text(
+        "stroke: breaststroke\nstroke_sha256: old\nweights: [0, 1]\ntempos: [1]\nspeed_m_s: [1]\n"
+        "turn_deg_per_cycle: {yaw_left: [[0, 1]]}\n")
+    with pytest.raises(ConfigError, match="stale"):
+        load_table(stroke, directory=tmp_path)
+
+
+def test_short_follow_gets_closer_to_a_fixed_target():
+    target = FixedTarget([6.0, 3.0, -0.2])
+    sim = build_swim("breaststroke", target=target).sim
+    mass = BODY.mass_kg / BODY.mass_kg.sum()
+    try:
+        start = np.linalg.norm(mass @ sim.state.pos_m - target.position(0.0))
+        sim.run(6.0)
+        end = np.linalg.norm(mass @ sim.state.pos_m - target.position(0.0))
+    finally:
+        sim.close()
+    assert end < start - 2.5
