@@ -71,8 +71,10 @@ def build_swim(stroke: str, lung_air_l: float | None = None, medium: Medium | No
         controller = StrokeController(parsed, tempo)
     else:
         if policy is None:
+            pace = tempo_control or TempoControl(min_tempo=parsed.steering.min_tempo,
+                                                 glide_within_m=parsed.steering.glide_within_m)
             policy = (TargetPolicy(target, load_table(parsed), parsed.start.posture, body.mass_kg / body.mass_kg.sum(),
-                                   tempo=tempo_control or TempoControl())
+                                   tempo=pace)
                       if layers.cycle else fixed_weights({}, tempo=tempo))
         controller = LayeredController(parsed, layout, arm_indices(body, layout), policy, layers)
     sim = Simulation(body, controller, medium if medium is not None else Medium(), SimConfig(physics_hz=physics_hz), layout=layout,

@@ -95,13 +95,12 @@ def _facing_change(arm, offsets, quat, flow_dir):
     from layered_swim.control.pose import quat_rotate
 
     normal = quat_rotate(quat[arm.hand], np.array([0.0, 1.0, 0.0]))
-    axes = np.vstack([quat_rotate(quat[arm.forearm], arm.wrist_axes),
-                      quat_rotate(quat[arm.upper_arm], arm.shoulder_rotation_axis)[None]])
+    axes = quat_rotate(quat[arm.forearm], arm.wrist_axes)
     facing = normal @ flow_dir
     return np.sign(facing or 1.0) * float(offsets[list(arm.palm_coords)] @ (np.cross(axes, normal) @ flow_dir))
 
 
-@pytest.mark.parametrize("hand_velocity", [[-1.0, 0.0, 0.3], [-1.0, -0.5, 0.3]])
+@pytest.mark.parametrize("hand_velocity", [[-1.0, -0.5, 0.3], [-1.0, 0.8, -0.2]])
 def test_palm_rule_faces_a_helpful_flow_and_slices_a_hindering_one(hand_velocity):
     arms = arm_indices(BODY, LAYOUT)
     quat = np.tile(PRONE_QUAT_XYZW, (16, 1))
@@ -109,12 +108,28 @@ def test_palm_rule_faces_a_helpful_flow_and_slices_a_hindering_one(hand_velocity
     velocity = np.zeros((16, 3))
     velocity[arm.hand] = hand_velocity          # the hand sweeps back: the water flows past it toward +x
     flow_dir = -velocity[arm.hand] / np.linalg.norm(velocity[arm.hand])
-    helpful = rule_offsets(arms, RulesSpec(), quat, velocity, np.zeros(3), np.array([1.0, 0.0, 0.0]), LAYOUT.size)
+    none = np.zeros(LAYOUT.size)
+    helpful = rule_offsets(none, arms, RulesSpec(), quat, velocity, np.zeros(3), np.array([1.0, 0.0, 0.0]), 0.01)
     assert _facing_change(arm, helpful, quat, flow_dir) > 0          # palm turns into the flow
     assert helpful[arm.elbow_coord] < 0                              # and the arm reaches further
-    hindering = rule_offsets(arms, RulesSpec(), quat, velocity, np.zeros(3), np.array([-1.0, 0.0, 0.0]), LAYOUT.size)
-    assert _facing_change(arm, hindering, quat, flow_dir) <= 0       # palm slices (stays edge-on)
+    hindering = rule_offsets(none, arms, RulesSpec(), quat, velocity, np.zeros(3), np.array([-1.0, 0.0, 0.0]), 0.01)
+    assert _facing_change(arm, hindering, quat, flow_dir) < 0        # palm slices
     assert hindering[arm.elbow_coord] > 0                            # and the arm stays closer
+
+
+def test_rule_offsets_fade_and_stay_within_their_limits():
+    arms = arm_indices(BODY, LAYOUT)
+    quat = np.tile(PRONE_QUAT_XYZW, (16, 1))
+    velocity = np.zeros((16, 3))
+    velocity[arms[0].hand] = [-1.0, -0.5, 0.3]
+    offsets = np.zeros(LAYOUT.size)
+    for _ in range(2000):                        # a long push saturates at max_deg
+        offsets = rule_offsets(offsets, arms, RulesSpec(), quat, velocity, np.zeros(3), np.array([1.0, 0, 0]), 0.01)
+    assert np.abs(np.degrees(offsets)).max() == pytest.approx(RulesSpec().palm.max_deg)
+    still = np.zeros((16, 3))                    # no flow past the hands: the offsets fade away
+    for _ in range(200):
+        offsets = rule_offsets(offsets, arms, RulesSpec(), quat, still, np.zeros(3), np.array([1.0, 0, 0]), 0.01)
+    assert np.abs(offsets).max() < 1e-3
 
 
 def test_missing_or_stale_calibration_is_a_clear_error(tmp_path):

@@ -15,7 +15,7 @@ import numpy as np
 
 from layered_swim.control.pose import JointLayout, quat_rotate
 from layered_swim.control.rules import ArmIndices, rule_offsets
-from layered_swim.control.steering import LATERAL_LOCAL
+from layered_swim.control.steering import FORWARD_LOCAL, LATERAL_LOCAL
 from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
 from layered_swim.sim.world import BodyState
 
@@ -50,6 +50,7 @@ class CycleChoice:
 
     weights: dict[str, float] = field(default_factory=dict)
     tempo: float = 1.0
+    glide: bool = False      # hold the cycle's first pose for one period instead of stroking
 
 
 class WeightPolicy(Protocol):
@@ -66,6 +67,8 @@ class LayeredController:
         self.reset()
 
     def reset(self) -> None:
+        self.rule_offsets = np.zeros(self.layout.size)
+        self._last_rule_time_s = None
         self.choice = CycleChoice()
         self.cycle = -1
         self.cycle_start_s = 0.0
@@ -78,6 +81,8 @@ class LayeredController:
         return self.choice.tempo / self.stroke.period_s
 
     def phase(self, time_s: float) -> float:
+        if self.choice.glide:
+            return float(self.cycle)
         return self.cycle + (time_s - self.cycle_start_s) * self.cycles_per_s
 
     def _start_cycle(self, time_s: float, state: BodyState | None) -> None:
@@ -96,6 +101,8 @@ class LayeredController:
             self._start_cycle(time_s, state)
         phase = self.phase(time_s)
         pose, rate = self.stroke.pose(phase)
+        if self.choice.glide:
+            rate = np.zeros_like(rate)
         for name, weight in self.choice.weights.items():
             if weight:
                 offset, offset_rate = self.stroke.perturbations[name].at(phase)
@@ -104,10 +111,21 @@ class LayeredController:
         if state is not None:
             self._track_roll(state)
             if (self.layers.palm or self.layers.reach) and self.water_velocity is not None:
-                pose = pose + rule_offsets(self.arms, self.stroke.rules, state.quat_xyzw, state.linvel_m_s,
-                                           self.water_velocity(state), self.desired_direction(state),
-                                           self.layout.size, self.layers.palm, self.layers.reach)
+                dt_s = time_s - self._last_rule_time_s if self._last_rule_time_s is not None else 0.0
+                self._last_rule_time_s = time_s
+                desired = self.desired_direction(state)
+                self.rule_offsets = rule_offsets(self.rule_offsets, self.arms, self.stroke.rules, state.quat_xyzw,
+                                                 state.linvel_m_s, self.water_velocity(state), desired, dt_s,
+                                                 self.layers.palm, self.layers.reach, self._engagement(state, desired))
+                pose = pose + self.rule_offsets
         return self.layout.clamp(pose), rate * self.cycles_per_s
+
+    def _engagement(self, state: BodyState, desired: np.ndarray) -> float:
+        """How much the rules push: fully when the target is ahead, fading to nothing as it moves
+        abeam. While turning, the per-cycle layer's left-right asymmetry is what is wanted, and
+        rules that maximise both hands' thrust would even it out."""
+        forward = quat_rotate(state.quat_xyzw[0], FORWARD_LOCAL[self.stroke.start.posture])
+        return max(0.0, float(forward @ desired)) ** 2
 
     def _track_roll(self, state: BodyState) -> None:
         lateral_z = quat_rotate(state.quat_xyzw[2], LATERAL_LOCAL)[2]

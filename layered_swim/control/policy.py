@@ -7,36 +7,45 @@ the target so the swimmer does not overshoot a slow target.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from layered_swim.control.calibration import CalibrationTable
 from layered_swim.control.layered import CycleChoice
-from layered_swim.control.steering import SteeringGains, attitude, wanted_turns
+from layered_swim.control.steering import SteeringGains, attitude, wanted_turns, wrap_angle
 from layered_swim.control.targets import Target
 from layered_swim.sim.world import BodyState
 
 
 @dataclass(frozen=True)
 class TempoControl:
-    """Full tempo beyond ``far_m`` from the target, ``min_tempo`` within ``near_m``."""
+    """Full tempo beyond ``far_m`` from the target, ``min_tempo`` within ``near_m``; also
+    ``min_tempo`` while the target is more than ``wide_turn_rad`` off the heading (swimming slower
+    tightens the turn: speed falls faster than the turn rate)."""
 
-    min_tempo: float = 0.7
+    min_tempo: float = 0.5
+    glide_within_m: float = 0.0
     near_m: float = 0.2
     far_m: float = 0.6
+    easy_turn_rad: float = math.radians(30.0)
+    wide_turn_rad: float = math.radians(90.0)
 
-    def tempo(self, distance_m: float) -> float:
-        x = (distance_m - self.near_m) / (self.far_m - self.near_m)
-        return float(self.min_tempo + (1.0 - self.min_tempo) * min(1.0, max(0.0, x)))
+    def tempo(self, distance_m: float, heading_error_rad: float = 0.0) -> float:
+        near = (distance_m - self.near_m) / (self.far_m - self.near_m)
+        straight = (self.wide_turn_rad - abs(heading_error_rad)) / (self.wide_turn_rad - self.easy_turn_rad)
+        x = min(1.0, max(0.0, min(near, straight)))
+        return float(self.min_tempo + (1.0 - self.min_tempo) * x)
 
 
 class TargetPolicy:
     def __init__(self, target: Target, table: CalibrationTable, posture: str, mass_fraction: np.ndarray,
-                 gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl()):
-        self.target, self.table, self.posture = target, table, posture
+                 gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead_s: float = 0.0):
+        self.target, self.table, self.posture, self.lead_s = target, table, posture, lead_s
         self.mass_fraction, self.gains, self.tempo_control = mass_fraction, gains, tempo
         self.last_wanted: dict[str, float] = {}
+        self._last_heading_rad: float | None = None
 
     def centre_of_mass(self, state: BodyState) -> np.ndarray:
         return self.mass_fraction @ state.pos_m
@@ -49,8 +58,14 @@ class TargetPolicy:
 
     def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float) -> CycleChoice:
         position = self.centre_of_mass(state)
-        target = self.target.position(state.time_s)
+        # Steer for where a moving target will be a little later: turning takes cycles.
+        target = self.target.position(state.time_s + self.lead_s)
         att = attitude(state.quat_xyzw[0], state.quat_xyzw[2], self.posture)
-        self.last_wanted = wanted_turns(att, mean_roll_rad, position, target, self.posture, self.gains)
-        tempo = self.tempo_control.tempo(float(np.linalg.norm(target - position)))
-        return CycleChoice(self.table.weights_for(self.last_wanted, tempo), tempo)
+        turned = wrap_angle(att.heading_rad - self._last_heading_rad) if self._last_heading_rad is not None else 0.0
+        self._last_heading_rad = att.heading_rad
+        self.last_wanted = wanted_turns(att, mean_roll_rad, position, target, self.posture, self.gains, turned)
+        heading_error = wrap_angle(math.atan2(target[1] - position[1], target[0] - position[0]) - att.heading_rad)
+        distance = float(np.linalg.norm(self.target.position(state.time_s) - position))
+        tempo = self.tempo_control.tempo(distance, heading_error)
+        glide = distance < self.tempo_control.glide_within_m and abs(heading_error) < self.tempo_control.easy_turn_rad
+        return CycleChoice({} if glide else self.table.weights_for(self.last_wanted, tempo), tempo, glide)

@@ -2,8 +2,9 @@
 
 * Palm orientation: when the water pushing on a hand helps toward the desired direction, turn
   the palm to face the relative flow (more force); when it hinders, turn the palm to slice
-  through it (less force). The wrist's two axes and the shoulder's internal rotation each move
-  along the gradient of how squarely the palm faces the flow.
+  through it (less force). Both are the gradient of one quantity, the hand's flat-plate thrust
+  along the desired direction, followed by the wrist's two axes. (Turning the shoulder too
+  swings the whole bent arm, which costs more than the palm gains.)
 * Arm reach: reach further (extend the elbow) while the hand's drag helps, keep the arm closer
   (flex the elbow) while it hinders.
 
@@ -27,38 +28,40 @@ MIN_FLOW_M_S = 0.05                             # below this the hand feels no u
 class ArmIndices:
     hand: int
     forearm: int
-    upper_arm: int
     wrist_axes: np.ndarray        # (2, 3) in the forearm frame
-    shoulder_rotation_axis: np.ndarray
-    palm_coords: tuple[int, int, int]   # wrist flexion, wrist deviation, shoulder internal rotation
+    palm_coords: tuple[int, int]        # wrist flexion, wrist deviation
     elbow_coord: int
 
 
 def arm_indices(body: Body, layout: JointLayout) -> list[ArmIndices]:
     arms = []
     for side in ("l", "r"):
-        wrist, shoulder = body.joint(f"wrist_{side}"), body.joint(f"shoulder_{side}")
+        wrist = body.joint(f"wrist_{side}")
         arms.append(ArmIndices(
             hand=body.index(f"hand_{side}"), forearm=body.index(f"forearm_{side}"),
-            upper_arm=body.index(f"upper_arm_{side}"),
-            wrist_axes=wrist.axes, shoulder_rotation_axis=shoulder.axes[2],
+            wrist_axes=wrist.axes,
             palm_coords=(layout.index(f"wrist_{side}.{wrist.axis_names[0]}"),
-                         layout.index(f"wrist_{side}.{wrist.axis_names[1]}"),
-                         layout.index(f"shoulder_{side}.{shoulder.axis_names[2]}")),
+                         layout.index(f"wrist_{side}.{wrist.axis_names[1]}")),
             elbow_coord=layout.index(f"elbow_{side}.flexion"),
         ))
     return arms
 
 
-def rule_offsets(arms: list[ArmIndices], rules: RulesSpec, quat_xyzw: np.ndarray, linvel_m_s: np.ndarray,
-                 water_m_s: np.ndarray, desired_dir: np.ndarray, size: int,
-                 palm: bool = True, reach: bool = True) -> np.ndarray:
-    """Pose offsets (rad) from the enabled rules; zero where a rule is off."""
-    offsets = np.zeros(size)
+RULE_MEMORY_S = 0.25   # offsets fade with this time constant once the flow stops asking for them
+
+
+def rule_offsets(previous: np.ndarray, arms: list[ArmIndices], rules: RulesSpec, quat_xyzw: np.ndarray,
+                 linvel_m_s: np.ndarray, water_m_s: np.ndarray, desired_dir: np.ndarray, dt_s: float,
+                 palm: bool = True, reach: bool = True, engagement: float = 1.0) -> np.ndarray:
+    """The rules' pose offsets (rad) after one control step of ``dt_s``: each offset moves along its
+    rule's gradient at ``engagement * gain`` rad/s per unit gradient, fades with RULE_MEMORY_S and
+    stays within ``max_deg``; zero where a rule is off."""
+    pull = np.zeros_like(previous)
+    limit = np.zeros_like(previous)
     palm = palm and rules.palm.enabled
     reach = reach and rules.reach.enabled
     if not (palm or reach):
-        return offsets
+        return np.zeros_like(previous)
     for arm in arms:
         flow = water_m_s - linvel_m_s[arm.hand]
         speed = float(np.linalg.norm(flow))
@@ -69,16 +72,17 @@ def rule_offsets(arms: list[ArmIndices], rules: RulesSpec, quat_xyzw: np.ndarray
         strength = min(speed, 1.0)
         if palm:
             normal = quat_rotate(quat_xyzw[arm.hand], PALM_NORMAL_LOCAL)
-            axes = np.vstack([quat_rotate(quat_xyzw[arm.forearm], arm.wrist_axes),
-                              quat_rotate(quat_xyzw[arm.upper_arm], arm.shoulder_rotation_axis)[None]])
-            facing = float(normal @ flow_dir)
-            turning = np.cross(axes, normal) @ flow_dir                     # d(facing)/d(angle) per axis
-            # More force: climb |facing| (its slope is not zero even when slicing edge-on);
-            # less force: descend facing^2, which settles smoothly at edge-on.
-            gradient = (1.0 if facing >= 0 else -1.0) * turning if helpfulness > 0 else 2.0 * facing * turning
-            step = rules.palm.gain * helpfulness * strength * gradient
-            offsets[list(arm.palm_coords)] = np.clip(step, -np.radians(rules.palm.max_deg), np.radians(rules.palm.max_deg))
+            axes = quat_rotate(quat_xyzw[arm.forearm], arm.wrist_axes)
+            turning = np.cross(axes, normal)                       # d(normal)/d(angle), one row per axis
+            facing, along = float(normal @ flow_dir), float(normal @ desired_dir)
+            # A flat plate's pressure force lies along its normal, ~ facing*|facing|; its useful part is
+            # that times the normal's component along the desired direction. Climb that thrust: the palm
+            # faces the flow when the push helps and slices through it when it hinders.
+            gradient = 2.0 * abs(facing) * along * (turning @ flow_dir) + facing * abs(facing) * (turning @ desired_dir)
+            pull[list(arm.palm_coords)] = rules.palm.gain * strength * gradient
+            limit[list(arm.palm_coords)] = np.radians(rules.palm.max_deg)
         if reach:
-            step = -rules.reach.gain * helpfulness * strength
-            offsets[arm.elbow_coord] = np.clip(step, -np.radians(rules.reach.max_deg), np.radians(rules.reach.max_deg))
-    return offsets
+            pull[arm.elbow_coord] = -rules.reach.gain * helpfulness * strength
+            limit[arm.elbow_coord] = np.radians(rules.reach.max_deg)
+    faded = previous * (1.0 - dt_s / RULE_MEMORY_S)
+    return np.clip(faded + engagement * pull * dt_s, -limit, limit)

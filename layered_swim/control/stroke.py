@@ -58,15 +58,23 @@ class PerturbationSpec(Strict):
 
 class RuleSpec(Strict):
     enabled: bool = True
-    gain: float = Field(1.0, ge=0.0, le=100.0)
-    max_deg: float = Field(30.0, gt=0.0, le=90.0)
+    gain: float = Field(30.0, ge=0.0, le=200.0)   # rad/s of offset per unit of the rule's gradient
+    max_deg: float = Field(35.0, gt=0.0, le=90.0)
 
 
 class RulesSpec(Strict):
     """Continuous-layer rules (Yang 4.4): palm orientation and arm reach."""
 
     palm: RuleSpec = RuleSpec()
-    reach: RuleSpec = RuleSpec(gain=0.5, max_deg=20.0)
+    reach: RuleSpec = RuleSpec(gain=2.0, max_deg=20.0)
+
+
+class SteeringSpec(Strict):
+    """How the per-cycle layer may change the stroke's pace: tempo down to ``min_tempo`` (below
+    it the stroke stops working), and gliding for a cycle when closer than ``glide_within_m``."""
+
+    min_tempo: float = Field(0.5, ge=0.1, le=1.0)
+    glide_within_m: float = Field(0.0, ge=0.0, le=10.0)
 
 
 class StrokeSpec(Strict):
@@ -80,6 +88,7 @@ class StrokeSpec(Strict):
     pd_gain_scale: dict[str, PositiveFloat] = {}
     perturbations: dict[Sequence, PerturbationSpec] = {}
     rules: RulesSpec = RulesSpec()
+    steering: SteeringSpec = SteeringSpec()
 
 
 @dataclass(frozen=True)
@@ -106,6 +115,7 @@ class Stroke:
     basic: CyclicTable                       # pose over one cycle, rad
     perturbations: dict[str, CyclicTable]    # offsets over one cycle at weight 1, rad
     rules: RulesSpec
+    steering: SteeringSpec
     pd_gain_scale: dict[str, float]
     source: str
     spec_sha256: str                         # of the parsed file: calibration tables check it
@@ -220,7 +230,7 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
             raise ConfigError(f"{source}: field 'pd_gain_scale.{joint}': unknown joint")
     digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json"), sort_keys=True).encode()).hexdigest()
     return Stroke(spec.name, spec.description, spec.period_s, spec.start, basic, perturbations, spec.rules,
-                  dict(spec.pd_gain_scale), source, digest)
+                  spec.steering, dict(spec.pd_gain_scale), source, digest)
 
 
 def _coord(layout: JointLayout, joints: set[str], joint: str, axis: str, where: str) -> int:
