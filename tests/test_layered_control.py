@@ -23,7 +23,7 @@ LAYOUT = joint_layout(BODY)
 
 def table(yaw_turns_deg=(0.0, 2.0, 4.0, 6.0, 8.0)) -> CalibrationTable:
     turns = np.radians([yaw_turns_deg])
-    return CalibrationTable("t", "x", (0.0, 0.25, 0.5, 0.75, 1.0), (1.0,), (0.8,),
+    return CalibrationTable("t", "x", (0.0, 0.25, 0.5, 0.75, 1.0), (1.0,), (0.8,), (0.0,), (0.0,),
                             {"yaw_left": turns, "yaw_right": turns / 2})
 
 
@@ -47,12 +47,13 @@ def test_weights_pick_the_sequence_that_turns_the_right_way():
 
 def test_wanted_turns_from_target_position():
     facing_x = Attitude(heading_rad=0.0, pitch_rad=0.0, roll_rad=0.0)
-    turns = wanted_turns(facing_x, 0.0, np.zeros(3), np.array([0.0, 5.0, 0.0]), "prone")
+    turns = wanted_turns(facing_x, np.zeros(3), np.array([0.0, 5.0, 0.0]), "prone")
     assert turns["yaw"] > 0                      # target on the left: turn left
-    assert wanted_turns(facing_x, 0.0, np.zeros(3), np.array([0.0, -5.0, 0.0]), "prone")["yaw"] < 0
-    deeper = wanted_turns(facing_x, 0.0, np.zeros(3), np.array([3.0, 0.0, -3.0]), "prone")
+    assert wanted_turns(facing_x, np.zeros(3), np.array([0.0, -5.0, 0.0]), "prone")["yaw"] < 0
+    deeper = wanted_turns(facing_x, np.zeros(3), np.array([3.0, 0.0, -3.0]), "prone")
     assert deeper["pitch"] < 0                   # target below: nose down
-    assert wanted_turns(facing_x, 0.1, np.zeros(3), np.array([5.0, 0, 0]), "prone")["roll"] > 0  # left up: roll left
+    left_up = Attitude(heading_rad=0.0, pitch_rad=0.0, roll_rad=0.1)
+    assert wanted_turns(left_up, np.zeros(3), np.array([5.0, 0, 0]), "prone")["roll"] > 0   # left up: roll left
 
 
 def test_layers_parse():
@@ -154,3 +155,29 @@ def test_short_follow_gets_closer_to_a_fixed_target():
     finally:
         sim.close()
     assert end < start - 2.5
+
+
+@pytest.mark.parametrize("stroke_name", ["breaststroke", "front_crawl", "treading_water"])
+def test_shipped_calibration_is_fresh_and_every_sequence_turns_monotonically(stroke_name):
+    """Yang Fig. 11: more weight, more turn, in every stroke, for every sequence and tempo."""
+    stroke = load_stroke(stroke_name, LAYOUT)
+    shipped = load_table(stroke)                       # raises if missing or stale
+    assert set(shipped.turn_rad) == set(stroke.perturbations) == set(
+        ("pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right"))
+    for name, rows in shipped.turn_rad.items():
+        assert np.all(np.diff(rows, axis=1) > 0), f"{stroke_name} {name}: {np.degrees(rows).round(2)}"
+
+
+def test_palm_rule_adds_forward_displacement():
+    """Yang Fig. 13: 10 s of breaststroke toward a target straight ahead, with and without the rule."""
+    target = FixedTarget([100.0, 0.0, -0.2])
+    travelled = {}
+    for layers in ("basic", "basic,palm"):
+        sim = build_swim("breaststroke", target=target, layers=Layers.parse(layers)).sim
+        try:
+            start = sim.state.pos_m[0, 0]
+            sim.run(10.0)
+            travelled[layers] = sim.state.pos_m[0, 0] - start
+        finally:
+            sim.close()
+    assert travelled["basic,palm"] >= 1.10 * travelled["basic"]

@@ -15,9 +15,12 @@ import numpy as np
 
 from layered_swim.control.pose import JointLayout, quat_rotate
 from layered_swim.control.rules import ArmIndices, rule_offsets
-from layered_swim.control.steering import FORWARD_LOCAL, LATERAL_LOCAL
+from layered_swim.control.steering import FORWARD_LOCAL, Attitude, attitude
 from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
 from layered_swim.sim.world import BodyState
+
+
+BLEND_CYCLES = 0.15   # a new cycle's weights take over within this fraction of it
 
 
 @dataclass(frozen=True)
@@ -54,7 +57,7 @@ class CycleChoice:
 
 
 class WeightPolicy(Protocol):
-    def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float) -> CycleChoice: ...
+    def __call__(self, cycle: int, state: BodyState, mean_attitude: Attitude | None) -> CycleChoice: ...
 
 
 class LayeredController:
@@ -67,14 +70,15 @@ class LayeredController:
         self.reset()
 
     def reset(self) -> None:
+        self._previous_weights: dict[str, float] = {}
         self.rule_offsets = np.zeros(self.layout.size)
         self._last_rule_time_s = None
         self.choice = CycleChoice()
         self.cycle = -1
         self.cycle_start_s = 0.0
-        self._roll_sum = 0.0
-        self._roll_n = 0
-        self.last_mean_roll_rad = 0.0
+        self._attitude_sum = np.zeros(4)     # cos heading, sin heading, pitch, roll
+        self._attitude_n = 0
+        self.last_mean_attitude: Attitude | None = None
 
     @property
     def cycles_per_s(self) -> float:
@@ -89,10 +93,13 @@ class LayeredController:
         if self.cycle >= 0:
             self.cycle_start_s += 1.0 / self.cycles_per_s
         self.cycle += 1
-        self.last_mean_roll_rad = self._roll_sum / self._roll_n if self._roll_n else 0.0
-        self._roll_sum, self._roll_n = 0.0, 0
+        if self._attitude_n:
+            c, sn, pitch, roll = self._attitude_sum / self._attitude_n
+            self.last_mean_attitude = Attitude(math.atan2(sn, c), pitch, roll)
+        self._previous_weights = dict(self.choice.weights)   # fully blended in by the cycle's end
+        self._attitude_sum[:], self._attitude_n = 0.0, 0
         if state is not None:
-            self.choice = self.policy(self.cycle, state, self.last_mean_roll_rad)
+            self.choice = self.policy(self.cycle, state, self.last_mean_attitude)
             if not self.layers.cycle:
                 self.choice = CycleChoice(tempo=self.choice.tempo)
 
@@ -103,13 +110,13 @@ class LayeredController:
         pose, rate = self.stroke.pose(phase)
         if self.choice.glide:
             rate = np.zeros_like(rate)
-        for name, weight in self.choice.weights.items():
+        for name, weight in self._blended_weights(time_s).items():
             if weight:
                 offset, offset_rate = self.stroke.perturbations[name].at(phase)
                 pose = pose + weight * offset
                 rate = rate + weight * offset_rate
         if state is not None:
-            self._track_roll(state)
+            self._track_attitude(state)
             if (self.layers.palm or self.layers.reach) and self.water_velocity is not None:
                 dt_s = time_s - self._last_rule_time_s if self._last_rule_time_s is not None else 0.0
                 self._last_rule_time_s = time_s
@@ -120,17 +127,33 @@ class LayeredController:
                 pose = pose + self.rule_offsets
         return self.layout.clamp(pose), rate * self.cycles_per_s
 
-    def _engagement(self, state: BodyState, desired: np.ndarray) -> float:
-        """How much the rules push: fully when the target is ahead, fading to nothing as it moves
-        abeam. While turning, the per-cycle layer's left-right asymmetry is what is wanted, and
-        rules that maximise both hands' thrust would even it out."""
-        forward = quat_rotate(state.quat_xyzw[0], FORWARD_LOCAL[self.stroke.start.posture])
-        return max(0.0, float(forward @ desired)) ** 2
+    def _blended_weights(self, time_s: float) -> dict[str, float]:
+        """This cycle's weights, eased in from the last cycle's over BLEND_CYCLES: a sequence need
+        not be zero at the cycle start (a mirror shifted half a cycle is not), so a switch of
+        weights must not jump the pose."""
+        progress = (time_s - self.cycle_start_s) * self.cycles_per_s / BLEND_CYCLES
+        if progress >= 1.0 or not self._previous_weights:
+            return self.choice.weights
+        ease = progress * progress * (3.0 - 2.0 * progress)
+        names = set(self.choice.weights) | set(self._previous_weights)
+        return {n: self._previous_weights.get(n, 0.0) + ease * (self.choice.weights.get(n, 0.0) - self._previous_weights.get(n, 0.0))
+                for n in names}
 
-    def _track_roll(self, state: BodyState) -> None:
-        lateral_z = quat_rotate(state.quat_xyzw[2], LATERAL_LOCAL)[2]
-        self._roll_sum += math.asin(max(-1.0, min(1.0, float(lateral_z))))
-        self._roll_n += 1
+    def _engagement(self, state: BodyState, desired: np.ndarray) -> float:
+        """How much the rules push: fully when the target is ahead and the cycle has no turn,
+        fading as the target moves abeam or the yaw weight grows. While turning, the per-cycle
+        layer's left-right asymmetry is what is wanted, and rules that maximise both hands'
+        thrust would even it out."""
+        forward = quat_rotate(state.quat_xyzw[0], FORWARD_LOCAL[self.stroke.start.posture])
+        turning = max(self.choice.weights.get("yaw_left", 0.0), self.choice.weights.get("yaw_right", 0.0))
+        return max(0.0, float(forward @ desired)) ** 2 * max(0.0, 1.0 - turning) ** 3
+
+    def _track_attitude(self, state: BodyState) -> None:
+        """Accumulate the cycle's mean attitude: strokes sway the pelvis within a cycle (a crawl
+        yaws and rolls with each arm), so steering reads the cycle average, not a sample."""
+        att = attitude(state.quat_xyzw[0], state.quat_xyzw[2], self.stroke.start.posture)
+        self._attitude_sum += (math.cos(att.heading_rad), math.sin(att.heading_rad), att.pitch_rad, att.roll_rad)
+        self._attitude_n += 1
 
 
 def fixed_weights(weights: dict[str, float], from_cycle: int = 0, tempo: float = 1.0) -> WeightPolicy:
@@ -139,6 +162,6 @@ def fixed_weights(weights: dict[str, float], from_cycle: int = 0, tempo: float =
     if unknown:
         raise ValueError(f"unknown perturbation sequences {sorted(unknown)}")
 
-    def policy(cycle: int, state: BodyState, mean_roll_rad: float) -> CycleChoice:
+    def policy(cycle: int, state: BodyState, mean_attitude: Attitude | None) -> CycleChoice:
         return CycleChoice(dict(weights) if cycle >= from_cycle else {}, tempo)
     return policy

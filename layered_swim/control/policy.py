@@ -14,7 +14,7 @@ import numpy as np
 
 from layered_swim.control.calibration import CalibrationTable
 from layered_swim.control.layered import CycleChoice
-from layered_swim.control.steering import SteeringGains, attitude, wanted_turns, wrap_angle
+from layered_swim.control.steering import Attitude, SteeringGains, attitude, wanted_turns, wrap_angle
 from layered_swim.control.targets import Target
 from layered_swim.sim.world import BodyState
 
@@ -41,11 +41,10 @@ class TempoControl:
 
 class TargetPolicy:
     def __init__(self, target: Target, table: CalibrationTable, posture: str, mass_fraction: np.ndarray,
-                 gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead_s: float = 0.0):
+                 gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead_s: float = 2.0):
         self.target, self.table, self.posture, self.lead_s = target, table, posture, lead_s
         self.mass_fraction, self.gains, self.tempo_control = mass_fraction, gains, tempo
         self.last_wanted: dict[str, float] = {}
-        self._last_heading_rad: float | None = None
 
     def centre_of_mass(self, state: BodyState) -> np.ndarray:
         return self.mass_fraction @ state.pos_m
@@ -56,16 +55,18 @@ class TargetPolicy:
         norm = float(np.linalg.norm(delta))
         return delta / norm if norm > 1e-9 else np.zeros(3)
 
-    def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float) -> CycleChoice:
+    def __call__(self, cycle: int, state: BodyState, mean_attitude: Attitude | None) -> CycleChoice:
         position = self.centre_of_mass(state)
         # Steer for where a moving target will be a little later: turning takes cycles.
         target = self.target.position(state.time_s + self.lead_s)
-        att = attitude(state.quat_xyzw[0], state.quat_xyzw[2], self.posture)
-        turned = wrap_angle(att.heading_rad - self._last_heading_rad) if self._last_heading_rad is not None else 0.0
-        self._last_heading_rad = att.heading_rad
-        self.last_wanted = wanted_turns(att, mean_roll_rad, position, target, self.posture, self.gains, turned)
+        now = attitude(state.quat_xyzw[0], state.quat_xyzw[2], self.posture)
+        # Heading and pitch as the cycle starts (the same phase every cycle, and current); roll
+        # averaged over the last cycle (a crawl rolls +-30 deg within it).
+        att = Attitude(now.heading_rad, now.pitch_rad, mean_attitude.roll_rad if mean_attitude else now.roll_rad)
         heading_error = wrap_angle(math.atan2(target[1] - position[1], target[0] - position[0]) - att.heading_rad)
         distance = float(np.linalg.norm(self.target.position(state.time_s) - position))
         tempo = self.tempo_control.tempo(distance, heading_error)
+        _, level_roll = self.table.attitude_at(tempo)   # pitch stays absolute: level swimming follows best
+        self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains, 0.0, level_roll)
         glide = distance < self.tempo_control.glide_within_m and abs(heading_error) < self.tempo_control.easy_turn_rad
         return CycleChoice({} if glide else self.table.weights_for(self.last_wanted, tempo), tempo, glide)

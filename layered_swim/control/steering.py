@@ -41,23 +41,23 @@ class SteeringGains:
     """How much of the error the layer tries to remove in one cycle, and pitch limits."""
 
     yaw_fraction: float = 0.7
-    yaw_damping: float = 0.5        # of last cycle's heading change, against overshoot (one cycle late)
     pitch_fraction: float = 0.5
     roll_fraction: float = 0.5
     max_glide_pitch_rad: float = math.radians(30.0)
 
 
-def wanted_turns(att: Attitude, mean_roll_rad: float, position_m: np.ndarray, target_m: np.ndarray,
-                 posture: str, gains: SteeringGains = SteeringGains(), last_yaw_change_rad: float = 0.0) -> dict[str, float]:
-    """Signed turns wanted this cycle: yaw (+ left), pitch (+ nose up), roll (+ toward the left,
-    i.e. left shoulder down). ``last_yaw_change_rad``, the heading change over the last cycle, damps
-    the yaw demand: the swimmer is still turning when the cycle starts."""
+def wanted_turns(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,
+                 posture: str, gains: SteeringGains = SteeringGains(), level_pitch_rad: float = 0.0,
+                 level_roll_rad: float = 0.0) -> dict[str, float]:
+    """Signed turns wanted this cycle from the swimmer's (cycle-mean) attitude: yaw (+ left), pitch
+    (+ nose up), roll (+ toward the left, i.e. left shoulder down). ``level_*`` is the stroke's own mean attitude when swimming straight
+    (legs a little low, a crawl's roll): pitch and roll are steered relative to it."""
     delta = np.asarray(target_m, float) - np.asarray(position_m, float)
     horizontal = math.hypot(delta[0], delta[1])
     yaw_error = wrap_angle(math.atan2(delta[1], delta[0]) - att.heading_rad) if horizontal > 1e-6 else 0.0
-    turns = {"yaw": gains.yaw_fraction * yaw_error - gains.yaw_damping * last_yaw_change_rad, "pitch": 0.0,
-             "roll": gains.roll_fraction * mean_roll_rad}
+    turns = {"yaw": gains.yaw_fraction * yaw_error, "pitch": 0.0,
+             "roll": gains.roll_fraction * (att.roll_rad - level_roll_rad)}
     if posture == "prone":
         glide = max(-gains.max_glide_pitch_rad, min(gains.max_glide_pitch_rad, math.atan2(delta[2], horizontal)))
-        turns["pitch"] = gains.pitch_fraction * (glide - att.pitch_rad)
+        turns["pitch"] = gains.pitch_fraction * (glide + level_pitch_rad - att.pitch_rad)
     return turns
