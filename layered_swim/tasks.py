@@ -12,6 +12,9 @@ from pathlib import Path
 import numpy as np
 
 from layered_swim.analysis import swim_benchmark as bench
+from layered_swim.body.model import load_body
+from layered_swim.control.pose import joint_layout
+from layered_swim.control.stroke import load_stroke
 from layered_swim.control.layered import Layers
 from layered_swim.control.policy import TempoControl
 from layered_swim.control.steering import attitude, wrap_angle
@@ -126,7 +129,7 @@ class ScheduledGoal:
         return bench.intermediate_goal(self.task, time_s, self.lead_s)
 
     def path_points(self, n: int = 400) -> np.ndarray:
-        return bench.goal_position(self.task, np.linspace(0.0, self.task.duration_s, n)[:, None] * np.ones((1, 1)))
+        return np.array([bench.goal_position(self.task, t) for t in np.linspace(0.0, self.task.duration_s, n)])
 
 
 GOAL_TEMPO = TempoControl(min_tempo=0.3, near_m=0.2, far_m=1.0)   # slow strokes: the goal line is slow
@@ -134,10 +137,7 @@ GOAL_TEMPO = TempoControl(min_tempo=0.3, near_m=0.2, far_m=1.0)   # slow strokes
 
 def goal_run(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layers = Layers()) -> dict:
     pool = bench.pool(pool_name)
-    from layered_swim.control.stroke import load_stroke  # the cycle time sets the intermediate-goal lead
-    from layered_swim.body.model import load_body
-    from layered_swim.control.pose import joint_layout
-    period_s = load_stroke(stroke, joint_layout(load_body())).period_s
+    period_s = load_stroke(stroke, joint_layout(load_body())).period_s   # sets the intermediate-goal lead
     per_goal = []
     for task in bench.goal_tasks(pool):
         target = ScheduledGoal(task, lead_s=period_s / 2)
