@@ -22,7 +22,7 @@ from layered_swim.config import ConfigError, load
 from layered_swim.control.calibration import load_table
 from layered_swim.control.layered import Layers, LayeredController, WeightPolicy, fixed_weights
 from layered_swim.control.policy import TargetPolicy, TempoControl
-from layered_swim.control.pose import joint_layout
+from layered_swim.control.pose import joint_layout, unit_vector
 from layered_swim.control.rules import arm_indices
 from layered_swim.control.targets import Target
 from layered_swim.control.stroke import Stroke, StrokeSpec, available_strokes, build_stroke, stroke_path
@@ -83,15 +83,10 @@ def build_swim(stroke: str, lung_air_l: float | None = None, medium: Medium | No
         controller.water_velocity = lambda state: sim.fluid.flow_at_swimmer(state.pos_m, state.quat_xyzw, state.linvel_m_s)
         if target is not None:
             mass_fraction = body.mass_kg / body.mass_kg.sum()
-            controller.desired_direction = lambda state: _unit(target.position(state.time_s) - mass_fraction @ state.pos_m)
+            controller.desired_direction = lambda state: unit_vector(target.position(state.time_s) - mass_fraction @ state.pos_m)
     start = parsed.start
     sim.reset(start.posture, start.depth_m, start.speed_m_s)
     return SwimSetup(parsed, spec, sim, np.random.default_rng(seed))
-
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    norm = float(np.linalg.norm(v))
-    return v / norm if norm > 1e-9 else np.zeros(3)
 
 
 def package_version() -> str:

@@ -13,7 +13,7 @@ import numpy as np
 
 from layered_swim.analysis import swim_benchmark as bench
 from layered_swim.body.model import load_body
-from layered_swim.control.pose import joint_layout
+from layered_swim.control.pose import joint_layout, unit_vector
 from layered_swim.control.stroke import load_stroke
 from layered_swim.control.layered import Layers
 from layered_swim.control.policy import TempoControl
@@ -27,14 +27,13 @@ TRACK_HZ = 20      # target-tracking samples per second
 
 @dataclass
 class Track:
-    """Swimmer (centre of mass) and target over time, plus what the per-cycle layer chose."""
+    """Swimmer (centre of mass) and target over time."""
 
     time_s: list
     swimmer_m: list
     target_m: list
     heading_error_rad: list
     roll_rad: list
-    weights: list
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {"track_time_s": np.array(self.time_s), "swimmer_m": np.array(self.swimmer_m),
@@ -52,7 +51,7 @@ def _swim_toward(target: Target, stroke: str, seconds: float, layers: Layers, cu
     sim.reset(start.posture, start.depth_m, speed, position_xy_m=start_xy)
     mass = sim.body.mass_kg / sim.body.mass_kg.sum()
     posture = start.posture
-    track = Track([], [], [], [], [], [])
+    track = Track([], [], [], [], [])
     every = sim.config.physics_hz // TRACK_HZ
     recorder = Recorder(sim) if recorder_dir is not None else None
 
@@ -67,7 +66,6 @@ def _swim_toward(target: Target, stroke: str, seconds: float, layers: Layers, cu
         track.target_m.append(goal)
         track.heading_error_rad.append(wrap_angle(math.atan2(goal[1] - com[1], goal[0] - com[0]) - att.heading_rad))
         track.roll_rad.append(att.roll_rad)
-        track.weights.append(dict(s.controller.choice.weights))
 
     def every_step(s) -> None:
         if recorder is not None:
@@ -105,7 +103,7 @@ def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = L
     if target.kind == "line":
         a = track.arrays()
         start = target.position(0.0)
-        direction = _unit(target.position(1.0) - start)
+        direction = unit_vector(target.position(1.0) - start)
         speed = float(np.linalg.norm(target.position(1.0) - start))
         tolerance = bench.ROLL_TOLERANCE_DEG.get(stroke, 45.0)
         result["swim_metrics"] = bench.straight_line_metrics(a["track_time_s"], a["swimmer_m"], np.degrees(a["roll_rad"]),
@@ -150,10 +148,6 @@ def goal_run(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layer
     mean = {k: float(np.mean([g[k] for g in per_goal])) for k in ("pos_m", "prog", "dev_m", "roll_deg")}
     return {"pool": pool_name, "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
             **mean, "goals": per_goal, "swim_published": bench.SWIM_PUBLISHED.get(pool_name)}
-
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / float(np.linalg.norm(v))
 
 
 def _dump(spec):

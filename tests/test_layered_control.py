@@ -23,7 +23,7 @@ LAYOUT = joint_layout(BODY)
 
 def table(yaw_turns_deg=(0.0, 2.0, 4.0, 6.0, 8.0)) -> CalibrationTable:
     turns = np.radians([yaw_turns_deg])
-    return CalibrationTable("t", "x", (0.0, 0.25, 0.5, 0.75, 1.0), (1.0,), (0.8,), (0.0,), (0.0,),
+    return CalibrationTable("t", "x", (0.0, 0.25, 0.5, 0.75, 1.0), (1.0,), (0.8,), (0.0,),
                             {"yaw_left": turns, "yaw_right": turns / 2})
 
 

@@ -37,13 +37,12 @@ class CalibrationTable:
     weights: tuple[float, ...]
     tempos: tuple[float, ...]
     speed_m_s: tuple[float, ...]               # steady speed at each tempo
-    pitch_rad: tuple[float, ...]               # the stroke's own cycle-mean pitch at each tempo
-    roll_rad: tuple[float, ...]                # and its cycle-mean shoulder roll (left up > 0)
+    roll_rad: tuple[float, ...]                # the stroke's own cycle-mean shoulder roll (left up > 0)
     turn_rad: dict[str, np.ndarray]            # per sequence (n_tempos, n_weights), in its own direction
 
-    def attitude_at(self, tempo: float) -> tuple[float, float]:
-        """The unperturbed stroke's mean pitch and roll: the level the per-cycle layer steers to."""
-        return float(np.interp(tempo, self.tempos, self.pitch_rad)), float(np.interp(tempo, self.tempos, self.roll_rad))
+    def roll_at(self, tempo: float) -> float:
+        """The unperturbed stroke's mean roll: the level the per-cycle layer steers back to."""
+        return float(np.interp(tempo, self.tempos, self.roll_rad))
 
     def turn_at(self, sequence: str, tempo: float) -> np.ndarray:
         rows = self.turn_rad[sequence]
@@ -84,7 +83,6 @@ def save_table(table: CalibrationTable, path: Path) -> Path:
         "weights": list(table.weights),
         "tempos": list(table.tempos),
         "speed_m_s": [round(s, 4) for s in table.speed_m_s],
-        "pitch_deg": [round(math.degrees(a), 3) for a in table.pitch_rad],
         "roll_deg": [round(math.degrees(a), 3) for a in table.roll_rad],
         "turn_deg_per_cycle": {name: [[round(math.degrees(v), 3) for v in row] for row in rows]
                                for name, rows in table.turn_rad.items()},
@@ -106,7 +104,6 @@ def load_table(stroke: Stroke, directory: Path = CALIBRATION_DIR) -> Calibration
             stroke=data["stroke"], stroke_sha256=data["stroke_sha256"],
             weights=tuple(float(w) for w in data["weights"]), tempos=tuple(float(t) for t in data["tempos"]),
             speed_m_s=tuple(float(s) for s in data["speed_m_s"]),
-            pitch_rad=tuple(math.radians(float(a)) for a in data["pitch_deg"]),
             roll_rad=tuple(math.radians(float(a)) for a in data["roll_deg"]),
             turn_rad={name: np.radians(np.array(rows, dtype=float)) for name, rows in data["turn_deg_per_cycle"].items()})
     except (KeyError, TypeError, ValueError) as err:
@@ -121,8 +118,8 @@ def load_table(stroke: Stroke, directory: Path = CALIBRATION_DIR) -> Calibration
 
 
 def _measure(job: tuple[str, str | None, float, float]) -> tuple:
-    """One calibration swim: (angle change per cycle about the sequence's axis, mean speed, and
-    the last cycle's mean pitch and roll); with no sequence the change is (yaw, pitch, roll)."""
+    """One calibration swim: (angle change per cycle about the sequence's axis, mean speed, the
+    last cycle's mean roll); with no sequence the change is (yaw, pitch, roll)."""
     from layered_swim.control.layered import Layers, fixed_weights
     from layered_swim.control.steering import attitude
     from layered_swim.runs import build_swim
@@ -160,8 +157,7 @@ def _measure(job: tuple[str, str | None, float, float]) -> tuple:
     change = (after - before) / MEASURE_CYCLES
     track = np.array(positions)
     speed = float(np.linalg.norm(track[-1, :2] - track[0, :2]) / (len(track) / sim.config.control_hz))
-    level = (float(after[1]), float(-after[2]))       # mean pitch, mean roll (left shoulder up > 0)
-    return (float(change[axis]) if sequence else change.tolist()), speed, level
+    return (float(change[axis]) if sequence else change.tolist()), speed, float(-after[2])   # roll: left up > 0
 
 
 def calibrate(stroke: Stroke, weights=WEIGHTS, tempos=TEMPOS, workers: int = 2, progress: bool = False) -> CalibrationTable:
@@ -179,8 +175,7 @@ def calibrate(stroke: Stroke, weights=WEIGHTS, tempos=TEMPOS, workers: int = 2, 
         results = list(results)
     baseline = {tempo: results[i][0] for i, tempo in enumerate(tempos)}      # drift with no perturbation
     speeds = tuple(results[i][1] for i in range(len(tempos)))
-    pitches = tuple(results[i][2][0] for i in range(len(tempos)))
-    rolls = tuple(results[i][2][1] for i in range(len(tempos)))
+    rolls = tuple(results[i][2] for i in range(len(tempos)))
     measured = iter(results[len(tempos):])
     turn_rad = {}
     for seq in sequences:
@@ -190,5 +185,5 @@ def calibrate(stroke: Stroke, weights=WEIGHTS, tempos=TEMPOS, workers: int = 2, 
         for tempo in tempos:
             rows.append([0.0] + [sign * (next(measured)[0] - baseline[tempo][k]) for w in weights if w > 0])
         turn_rad[seq] = np.array(rows)
-    return CalibrationTable(stroke.name, stroke.spec_sha256, tuple(weights), tuple(tempos), speeds, pitches, rolls,
+    return CalibrationTable(stroke.name, stroke.spec_sha256, tuple(weights), tuple(tempos), speeds, rolls,
                             turn_rad)

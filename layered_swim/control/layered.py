@@ -13,9 +13,10 @@ from typing import Callable, Protocol
 
 import numpy as np
 
+from layered_swim.config import ConfigError
 from layered_swim.control.pose import JointLayout, quat_rotate
 from layered_swim.control.rules import ArmIndices, rule_offsets
-from layered_swim.control.steering import FORWARD_LOCAL, Attitude, attitude
+from layered_swim.control.steering import FORWARD_LOCAL, LATERAL_LOCAL
 from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
 from layered_swim.sim.world import BodyState
 
@@ -32,8 +33,6 @@ class Layers:
     @classmethod
     def parse(cls, text: str) -> "Layers":
         """``basic``, ``basic,cycle``, ``basic,cycle,rules`` or with ``palm``/``reach`` alone."""
-        from layered_swim.config import ConfigError
-
         names = {n.strip() for n in text.split(",") if n.strip()}
         unknown = names - {"basic", "cycle", "rules", "palm", "reach"}
         if unknown or "basic" not in names:
@@ -57,7 +56,7 @@ class CycleChoice:
 
 
 class WeightPolicy(Protocol):
-    def __call__(self, cycle: int, state: BodyState, mean_attitude: Attitude | None) -> CycleChoice: ...
+    def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice: ...
 
 
 class LayeredController:
@@ -76,9 +75,9 @@ class LayeredController:
         self.choice = CycleChoice()
         self.cycle = -1
         self.cycle_start_s = 0.0
-        self._attitude_sum = np.zeros(4)     # cos heading, sin heading, pitch, roll
-        self._attitude_n = 0
-        self.last_mean_attitude: Attitude | None = None
+        self._roll_sum = 0.0
+        self._roll_n = 0
+        self.last_mean_roll_rad: float | None = None
 
     @property
     def cycles_per_s(self) -> float:
@@ -93,13 +92,12 @@ class LayeredController:
         if self.cycle >= 0:
             self.cycle_start_s += 1.0 / self.cycles_per_s
         self.cycle += 1
-        if self._attitude_n:
-            c, sn, pitch, roll = self._attitude_sum / self._attitude_n
-            self.last_mean_attitude = Attitude(math.atan2(sn, c), pitch, roll)
+        if self._roll_n:
+            self.last_mean_roll_rad = self._roll_sum / self._roll_n
         self._previous_weights = dict(self.choice.weights)   # fully blended in by the cycle's end
-        self._attitude_sum[:], self._attitude_n = 0.0, 0
+        self._roll_sum, self._roll_n = 0.0, 0
         if state is not None:
-            self.choice = self.policy(self.cycle, state, self.last_mean_attitude)
+            self.choice = self.policy(self.cycle, state, self.last_mean_roll_rad)
             if not self.layers.cycle:
                 self.choice = CycleChoice(tempo=self.choice.tempo)
 
@@ -116,7 +114,7 @@ class LayeredController:
                 pose = pose + weight * offset
                 rate = rate + weight * offset_rate
         if state is not None:
-            self._track_attitude(state)
+            self._track_roll(state)
             if (self.layers.palm or self.layers.reach) and self.water_velocity is not None:
                 dt_s = time_s - self._last_rule_time_s if self._last_rule_time_s is not None else 0.0
                 self._last_rule_time_s = time_s
@@ -148,12 +146,12 @@ class LayeredController:
         turning = max(self.choice.weights.get("yaw_left", 0.0), self.choice.weights.get("yaw_right", 0.0))
         return max(0.0, float(forward @ desired)) ** 2 * max(0.0, 1.0 - turning) ** 3
 
-    def _track_attitude(self, state: BodyState) -> None:
-        """Accumulate the cycle's mean attitude: strokes sway the pelvis within a cycle (a crawl
-        yaws and rolls with each arm), so steering reads the cycle average, not a sample."""
-        att = attitude(state.quat_xyzw[0], state.quat_xyzw[2], self.stroke.start.posture)
-        self._attitude_sum += (math.cos(att.heading_rad), math.sin(att.heading_rad), att.pitch_rad, att.roll_rad)
-        self._attitude_n += 1
+    def _track_roll(self, state: BodyState) -> None:
+        """Accumulate the cycle's mean shoulder roll: a crawl rolls +-30 deg within a cycle, so
+        steering reads the cycle average, not a sample."""
+        lateral_z = float(quat_rotate(np.asarray(state.quat_xyzw[2], float), LATERAL_LOCAL)[2])
+        self._roll_sum += math.asin(max(-1.0, min(1.0, lateral_z)))
+        self._roll_n += 1
 
 
 def fixed_weights(weights: dict[str, float], from_cycle: int = 0, tempo: float = 1.0) -> WeightPolicy:
@@ -162,6 +160,6 @@ def fixed_weights(weights: dict[str, float], from_cycle: int = 0, tempo: float =
     if unknown:
         raise ValueError(f"unknown perturbation sequences {sorted(unknown)}")
 
-    def policy(cycle: int, state: BodyState, mean_attitude: Attitude | None) -> CycleChoice:
+    def policy(cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
         return CycleChoice(dict(weights) if cycle >= from_cycle else {}, tempo)
     return policy

@@ -1,7 +1,8 @@
 """The per-cycle weight policy that steers toward a target (Yang 4.3 + section 5).
 
 At each cycle start: where is the target relative to the swimmer (heading error, depth, and the
-shoulder roll averaged over the last cycle), how much of that to correct this cycle, and which
+shoulder roll averaged over the last cycle against the stroke's own), how much of that to correct
+this cycle, and which
 weights the calibration table says produce those turns. The cycle's tempo slows the stroke near
 the target so the swimmer does not overshoot a slow target.
 """
@@ -46,27 +47,17 @@ class TargetPolicy:
         self.mass_fraction, self.gains, self.tempo_control = mass_fraction, gains, tempo
         self.last_wanted: dict[str, float] = {}
 
-    def centre_of_mass(self, state: BodyState) -> np.ndarray:
-        return self.mass_fraction @ state.pos_m
-
-    def direction(self, state: BodyState) -> np.ndarray:
-        """Unit vector from the swimmer to the target (the continuous rules' desired direction)."""
-        delta = self.target.position(state.time_s) - self.centre_of_mass(state)
-        norm = float(np.linalg.norm(delta))
-        return delta / norm if norm > 1e-9 else np.zeros(3)
-
-    def __call__(self, cycle: int, state: BodyState, mean_attitude: Attitude | None) -> CycleChoice:
-        position = self.centre_of_mass(state)
+    def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
+        position = self.mass_fraction @ state.pos_m
         # Steer for where a moving target will be a little later: turning takes cycles.
         target = self.target.position(state.time_s + self.lead_s)
         now = attitude(state.quat_xyzw[0], state.quat_xyzw[2], self.posture)
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); roll
         # averaged over the last cycle (a crawl rolls +-30 deg within it).
-        att = Attitude(now.heading_rad, now.pitch_rad, mean_attitude.roll_rad if mean_attitude else now.roll_rad)
+        att = Attitude(now.heading_rad, now.pitch_rad, now.roll_rad if mean_roll_rad is None else mean_roll_rad)
         heading_error = wrap_angle(math.atan2(target[1] - position[1], target[0] - position[0]) - att.heading_rad)
         distance = float(np.linalg.norm(self.target.position(state.time_s) - position))
         tempo = self.tempo_control.tempo(distance, heading_error)
-        _, level_roll = self.table.attitude_at(tempo)   # pitch stays absolute: level swimming follows best
-        self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains, 0.0, level_roll)
+        self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains, self.table.roll_at(tempo))
         glide = distance < self.tempo_control.glide_within_m and abs(heading_error) < self.tempo_control.easy_turn_rad
         return CycleChoice({} if glide else self.table.weights_for(self.last_wanted, tempo), tempo, glide)

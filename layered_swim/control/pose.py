@@ -26,6 +26,12 @@ def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     ], axis=-1)
 
 
+def unit_vector(v: np.ndarray) -> np.ndarray:
+    """``v`` scaled to length 1 (zero stays zero)."""
+    norm = float(np.linalg.norm(v))
+    return v / norm if norm > 1e-9 else np.zeros_like(v)
+
+
 def quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Rotate vectors v (..., 3) by unit quaternions q (..., 4)."""
     u, w = q[..., :3], q[..., 3:4]

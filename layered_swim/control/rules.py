@@ -56,12 +56,12 @@ def rule_offsets(previous: np.ndarray, arms: list[ArmIndices], rules: RulesSpec,
     """The rules' pose offsets (rad) after one control step of ``dt_s``: each offset moves along its
     rule's gradient at ``engagement * gain`` rad/s per unit gradient, fades with RULE_MEMORY_S and
     stays within ``max_deg``; zero where a rule is off."""
-    pull = np.zeros_like(previous)
-    limit = np.zeros_like(previous)
     palm = palm and rules.palm.enabled
     reach = reach and rules.reach.enabled
     if not (palm or reach):
         return np.zeros_like(previous)
+    pull = np.zeros_like(previous)
+    limit = np.zeros_like(previous)
     for arm in arms:
         flow = water_m_s - linvel_m_s[arm.hand]
         speed = float(np.linalg.norm(flow))

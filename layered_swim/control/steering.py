@@ -47,11 +47,10 @@ class SteeringGains:
 
 
 def wanted_turns(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,
-                 posture: str, gains: SteeringGains = SteeringGains(), level_pitch_rad: float = 0.0,
-                 level_roll_rad: float = 0.0) -> dict[str, float]:
-    """Signed turns wanted this cycle from the swimmer's (cycle-mean) attitude: yaw (+ left), pitch
-    (+ nose up), roll (+ toward the left, i.e. left shoulder down). ``level_*`` is the stroke's own mean attitude when swimming straight
-    (legs a little low, a crawl's roll): pitch and roll are steered relative to it."""
+                 posture: str, gains: SteeringGains = SteeringGains(), level_roll_rad: float = 0.0) -> dict[str, float]:
+    """Signed turns wanted this cycle: yaw (+ left), pitch (+ nose up, toward the glide angle to the
+    target's depth), roll (+ toward the left, i.e. left shoulder down) back to ``level_roll_rad``,
+    the stroke's own mean roll when swimming straight."""
     delta = np.asarray(target_m, float) - np.asarray(position_m, float)
     horizontal = math.hypot(delta[0], delta[1])
     yaw_error = wrap_angle(math.atan2(delta[1], delta[0]) - att.heading_rad) if horizontal > 1e-6 else 0.0
@@ -59,5 +58,5 @@ def wanted_turns(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,
              "roll": gains.roll_fraction * (att.roll_rad - level_roll_rad)}
     if posture == "prone":
         glide = max(-gains.max_glide_pitch_rad, min(gains.max_glide_pitch_rad, math.atan2(delta[2], horizontal)))
-        turns["pitch"] = gains.pitch_fraction * (glide + level_pitch_rad - att.pitch_rad)
+        turns["pitch"] = gains.pitch_fraction * (glide - att.pitch_rad)
     return turns
