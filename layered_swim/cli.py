@@ -1,4 +1,4 @@
-"""``layered-swim``: headless runs, the stroke list, the drag validation and the step benchmark.
+"""``layered-swim``: headless runs, target following, calibration, benchmarks and rendering.
 
 Heavy modules are imported inside the commands: PyBullet must not be loaded before ``main``
 has moved C-level stdout out of the way (see ``_guard_stdout``).
@@ -73,6 +73,19 @@ def _parser() -> argparse.ArgumentParser:
     goal.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
     goal.add_argument("--layers", default="basic,cycle,rules")
     goal.add_argument("--json", action="store_true")
+
+    render = sub.add_parser("render", help="draw a run folder or a trajectory swim to a video or PNG frames, no display needed")
+    render.add_argument("source", help="a folder written by `run`/`follow --out` (replayed), or a trajectory (swum now)")
+    render.add_argument("--out", required=True, help="video.mp4 (needs the video extra; else PNG frames) or a folder for PNGs")
+    render.add_argument("--seconds", type=float, help="length (default: the whole run, or 20 s of a trajectory)")
+    render.add_argument("--fps", type=float, default=30.0)
+    render.add_argument("--size", default="960x540", metavar="WxH")
+    render.add_argument("--stroke", default="breaststroke", help="stroke for a trajectory (default breaststroke)")
+    render.add_argument("--layers", default="basic,cycle,rules")
+    render.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
+    render.add_argument("--density", type=float, metavar="KG_M3")
+    render.add_argument("--forces", action="store_true", help="draw the per-segment fluid-force arrows")
+    render.add_argument("--no-progress", action="store_true", help="no progress bar")
 
     bench = sub.add_parser("bench", help="time one physics step, bare and through the whole loop")
     bench.add_argument("--json", action="store_true")
@@ -159,6 +172,18 @@ def _vector(text: str, what: str) -> tuple[float, float, float]:
     return values
 
 
+def _size(text: str) -> tuple[int, int]:
+    from layered_swim.config import ConfigError
+
+    try:
+        width, height = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise ConfigError(f"--size must be WIDTHxHEIGHT in pixels, e.g. 1280x720, got '{text}'") from None
+    if not (16 <= width <= 3840 and 16 <= height <= 2160):
+        raise ConfigError(f"--size must be between 16x16 and 3840x2160, got '{text}'")
+    return width, height
+
+
 def _cmd_calibrate(args) -> None:
     from layered_swim.body.model import load_body
     from layered_swim.control.calibration import calibrate, calibration_path, save_table
@@ -204,8 +229,20 @@ def _cmd_goal(args) -> None:
     print(_table(rows, ["", "Pos m", "Prog", "Dev m", "Roll deg"]))
 
 
+def _cmd_render(args) -> None:
+    from layered_swim.app.render import render
+    from layered_swim.control.layered import Layers
+
+    result = render(args.source, args.out, args.seconds, args.fps, _size(args.size), args.stroke, Layers.parse(args.layers),
+                    _vector(args.current, "--current"), args.density, args.forces,
+                    progress=not args.no_progress and sys.stderr.isatty())
+    if not result["video"] and Path(args.out).suffix.lower() == ".mp4":
+        print(f"{PROG}: note: {result['note']}", file=sys.stderr)
+    print(f"wrote {result['frames']} frames to {result['out']}")
+
+
 COMMANDS = {"run": _cmd_run, "strokes": _cmd_strokes, "validate": _cmd_validate, "bench": _cmd_bench,
-            "calibrate": _cmd_calibrate, "follow": _cmd_follow, "goal": _cmd_goal}
+            "calibrate": _cmd_calibrate, "follow": _cmd_follow, "goal": _cmd_goal, "render": _cmd_render}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -30,6 +30,10 @@ SETTLE_CYCLES = 3
 MEASURE_CYCLES = 2
 
 
+class CalibrationError(ConfigError):
+    """The stroke's table is missing, malformed or stale: the per-cycle layer cannot steer it."""
+
+
 @dataclass(frozen=True)
 class CalibrationTable:
     stroke: str
@@ -97,7 +101,7 @@ def load_table(stroke: Stroke, directory: Path = CALIBRATION_DIR) -> Calibration
     path = calibration_path(stroke.name, directory)
     remake = f"run `layered-swim calibrate --stroke {stroke.name}`"
     if not path.exists():
-        raise ConfigError(f"{path}: no calibration table for stroke '{stroke.name}'; {remake}")
+        raise CalibrationError(f"{path}: no calibration table for stroke '{stroke.name}'; {remake}")
     data = load_yaml(path)
     try:
         table = CalibrationTable(
@@ -107,12 +111,12 @@ def load_table(stroke: Stroke, directory: Path = CALIBRATION_DIR) -> Calibration
             roll_rad=tuple(math.radians(float(a)) for a in data["roll_deg"]),
             turn_rad={name: np.radians(np.array(rows, dtype=float)) for name, rows in data["turn_deg_per_cycle"].items()})
     except (KeyError, TypeError, ValueError) as err:
-        raise ConfigError(f"{path}: malformed calibration table ({err}); {remake}") from None
+        raise CalibrationError(f"{path}: malformed calibration table ({err}); {remake}") from None
     if table.stroke_sha256 != stroke.spec_sha256:
-        raise ConfigError(f"{path}: stale calibration table (stroke file {stroke.source} changed since); {remake}")
+        raise CalibrationError(f"{path}: stale calibration table (stroke file {stroke.source} changed since); {remake}")
     for name, rows in table.turn_rad.items():
         if rows.shape != (len(table.tempos), len(table.weights)) or not np.isfinite(rows).all():
-            raise ConfigError(f"{path}: field 'turn_deg_per_cycle.{name}': expected {len(table.tempos)} rows "
+            raise CalibrationError(f"{path}: field 'turn_deg_per_cycle.{name}': expected {len(table.tempos)} rows "
                               f"of {len(table.weights)} finite numbers; {remake}")
     return table
 

@@ -88,6 +88,11 @@ class Simulation:
     def time_s(self) -> float:
         return self.world.time_s
 
+    def set_medium(self, medium: Medium) -> None:
+        """Change the fluid (density, current) mid-run: the swimmer carries on in the new water."""
+        self.medium = medium
+        self.fluid = ThinPlateFluid(self.body, medium)
+
     def reset(self, posture: str = "prone", depth_m: float = 0.1, speed_m_s: float = 0.0,
               heading_rad: float = 0.0, position_xy_m: tuple[float, float] = (0.0, 0.0)) -> None:
         base = PRONE_QUAT_XYZW if posture == "prone" else UPRIGHT_QUAT_XYZW

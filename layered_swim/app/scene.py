@@ -1,0 +1,140 @@
+"""What a frame shows, as plain arrays, and the geometry built from it (pure numpy, no OpenGL).
+
+The live app and the headless renderer both describe a frame as a ``Scene``; ``renderer.py``
+turns one into triangles and lines on the GPU.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+SKIN = (0.93, 0.72, 0.58)
+SUIT = (0.75, 0.12, 0.16)
+CAP = (1.0, 0.82, 0.15)
+TARGET_COLOR = (1.0, 0.1, 0.85, 1.0)        # magenta: no other thing in the scene has this hue
+TRAIL_COLOR = (1.0, 1.0, 1.0, 1.0)
+PATH_COLOR = (1.0, 0.55, 0.9, 1.0)
+FORCE_COLOR = (0.1, 1.0, 0.3, 1.0)
+CURRENT_COLOR = (0.2, 0.95, 1.0, 1.0)
+GRID_COLOR = (0.05, 0.2, 0.35, 1.0)
+WATER_COLOR = (0.08, 0.42, 0.68, 0.5)
+SKY_COLOR = (0.66, 0.8, 0.92, 1.0)
+
+FORCE_SCALE_M_PER_N = 0.004     # a 100 N fluid force draws as a 0.4 m arrow
+CURRENT_SCALE_M_PER_M_S = 2.0
+MARKER_SIZE_M = 0.22
+GRID_DEPTH_M = 3.0               # the open-water grid lies this far below the surface
+GRID_SPACING_M = 2.0
+GRID_HALF_LINES = 20
+
+# 12 triangles of a unit box: corner sign patterns and each triangle's outward face normal.
+_FACES = [  # (normal, four corners counterclockwise seen from outside)
+    ((1, 0, 0), [(1, -1, -1), (1, 1, -1), (1, 1, 1), (1, -1, 1)]),
+    ((-1, 0, 0), [(-1, 1, -1), (-1, -1, -1), (-1, -1, 1), (-1, 1, 1)]),
+    ((0, 1, 0), [(1, 1, -1), (-1, 1, -1), (-1, 1, 1), (1, 1, 1)]),
+    ((0, -1, 0), [(-1, -1, -1), (1, -1, -1), (1, -1, 1), (-1, -1, 1)]),
+    ((0, 0, 1), [(-1, -1, 1), (1, -1, 1), (1, 1, 1), (-1, 1, 1)]),
+    ((0, 0, -1), [(-1, 1, -1), (1, 1, -1), (1, -1, -1), (-1, -1, -1)]),
+]
+BOX_CORNERS = np.array([quad[i] for _, quad in _FACES for i in (0, 1, 2, 0, 2, 3)], dtype=float)   # (36, 3)
+BOX_NORMALS = np.array([n for n, _ in _FACES for _ in range(6)], dtype=float)                      # (36, 3)
+BOX_VERTICES = len(BOX_CORNERS)
+
+# An octahedron: the target marker.
+_OCTA_TIPS = np.array([(1, 0, 0), (0, 1, 0), (-1, 0, 0), (0, -1, 0)], dtype=float)
+MARKER_TRIANGLES = np.array([[tip, _OCTA_TIPS[(i + 1) % 4], (0, 0, s)] for s in (1.0, -1.0)
+                             for i, tip in enumerate(_OCTA_TIPS)])                                # (8, 3, 3)
+MARKER_VERTICES = MARKER_TRIANGLES.shape[0] * 3
+
+
+@dataclass
+class Scene:
+    segment_names: tuple[str, ...]
+    half_extents_m: np.ndarray        # (n, 3)
+    segment_pos_m: np.ndarray         # (n, 3)
+    segment_quat_xyzw: np.ndarray     # (n, 4)
+    target_m: np.ndarray | None = None
+    path_m: np.ndarray | None = None  # the scripted target's whole path
+    trail_m: np.ndarray | None = None # the swimmer's recent track
+    forces_n: np.ndarray | None = None
+    current_m_s: np.ndarray | None = None
+
+    @property
+    def centre_of_segments_m(self) -> np.ndarray:
+        return self.segment_pos_m.mean(axis=0)
+
+
+def segment_colors(names: tuple[str, ...]) -> np.ndarray:
+    """RGBA per segment: cap on the head, suit on the trunk, skin on the limbs; the left side a
+    shade darker so the roll and the arm phase read at a glance."""
+    colors = []
+    for name in names:
+        rgb = CAP if name == "head" else SUIT if name in ("pelvis", "abdomen", "thorax") else SKIN
+        if name in ("thorax", "abdomen"):
+            rgb = tuple(0.55 * c + 0.45 * s for c, s in zip(rgb, SKIN))
+        shade = 0.8 if name.startswith("left") else 1.0
+        colors.append((*(shade * c for c in rgb), 1.0))
+    return np.array(colors)
+
+
+def rotation_matrices(quat_xyzw: np.ndarray) -> np.ndarray:
+    x, y, z, w = np.moveaxis(np.asarray(quat_xyzw, float), -1, 0)
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+    ], -2)
+
+
+def box_triangles(pos_m: np.ndarray, quat_xyzw: np.ndarray, half_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and normals (n * 36, 3) of every segment's box, in segment order."""
+    rot = rotation_matrices(quat_xyzw)
+    local = BOX_CORNERS[None, :, :] * half_m[:, None, :]
+    vertices = pos_m[:, None, :] + np.einsum("sij,svj->svi", rot, local)
+    normals = np.einsum("sij,vj->svi", rot, BOX_NORMALS)
+    return vertices.reshape(-1, 3), normals.reshape(-1, 3)
+
+
+def marker_triangles(centre_m: np.ndarray, size_m: float = MARKER_SIZE_M) -> tuple[np.ndarray, np.ndarray]:
+    vertices = centre_m + size_m * MARKER_TRIANGLES.reshape(-1, 3) * np.array([1.0, 1.0, 1.6])
+    tri = vertices.reshape(-1, 3, 3)
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    return vertices, np.repeat(normal, 3, axis=0)
+
+
+def arrow_lines(starts_m: np.ndarray, vectors_m: np.ndarray, head_fraction: float = 0.25) -> np.ndarray:
+    """Line-segment endpoints (k * 6, 3) for arrows: a shaft and a two-stroke head each."""
+    starts_m, vectors_m = np.atleast_2d(starts_m), np.atleast_2d(vectors_m)
+    ends = starts_m + vectors_m
+    length = np.linalg.norm(vectors_m, axis=1, keepdims=True)
+    direction = vectors_m / np.maximum(length, 1e-9)
+    side = np.cross(direction, [0.0, 0.0, 1.0])
+    flat = np.linalg.norm(side, axis=1) < 1e-6                 # vertical arrow: any horizontal side
+    side[flat] = [1.0, 0.0, 0.0]
+    side /= np.linalg.norm(side, axis=1, keepdims=True)
+    back = ends - head_fraction * vectors_m
+    spread = 0.5 * head_fraction * length * side
+    lines = np.stack([starts_m, ends, ends, back + spread, ends, back - spread], axis=1)
+    return lines.reshape(-1, 3)
+
+
+def polyline_lines(points_m: np.ndarray) -> np.ndarray:
+    """Line-segment endpoints joining consecutive points."""
+    points_m = np.asarray(points_m, float)
+    if len(points_m) < 2:
+        return np.zeros((0, 3))
+    return np.stack([points_m[:-1], points_m[1:]], axis=1).reshape(-1, 3)
+
+
+def grid_lines(centre_m: np.ndarray, z_m: float = -GRID_DEPTH_M, spacing_m: float = GRID_SPACING_M,
+               half_lines: int = GRID_HALF_LINES) -> np.ndarray:
+    """A square grid snapped to world multiples of the spacing (so it stays put as the camera
+    follows the swimmer)."""
+    cx, cy = (np.round(np.asarray(centre_m[:2]) / spacing_m) * spacing_m)
+    extent = half_lines * spacing_m
+    offsets = np.arange(-half_lines, half_lines + 1) * spacing_m
+    along_x = [((cx - extent, cy + o, z_m), (cx + extent, cy + o, z_m)) for o in offsets]
+    along_y = [((cx + o, cy - extent, z_m), (cx + o, cy + extent, z_m)) for o in offsets]
+    return np.array(along_x + along_y, dtype=float).reshape(-1, 3)

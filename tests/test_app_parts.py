@@ -1,0 +1,169 @@
+"""The app's parts that need no window: camera picking, scene geometry, the interactive session's
+clock and switches, the HUD text and the frame writer."""
+import math
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from layered_swim.app import scene as sc
+from layered_swim.app.camera import OrbitCamera, look_at, perspective
+from layered_swim.app.frames import FrameWriter
+from layered_swim.app.hud import hud_lines
+from layered_swim.app.render import frame_steps
+from layered_swim.app.session import MAX_LAG_S, SLOW_MOTION, SwimSession
+from layered_swim.config import ConfigError
+
+
+def test_look_at_puts_the_focus_straight_ahead():
+    view = look_at(np.array([0.0, -5.0, 0.0]), np.zeros(3))
+    assert view @ np.array([0.0, 0.0, 0.0, 1.0]) == pytest.approx([0.0, 0.0, -5.0, 1.0])
+    assert view @ np.array([1.0, 0.0, 0.0, 1.0]) == pytest.approx([1.0, 0.0, -5.0, 1.0])   # world +x is screen right
+
+
+def test_perspective_maps_near_and_far_planes_to_the_depth_range():
+    m = perspective(math.radians(60), 2.0, 0.1, 100.0)
+    for z, ndc in ((-0.1, -1.0), (-100.0, 1.0)):
+        clip = m @ np.array([0.0, 0.0, z, 1.0])
+        assert clip[2] / clip[3] == pytest.approx(ndc)
+
+
+def test_water_point_inverts_projection():
+    camera = OrbitCamera(focus_m=np.array([3.0, -2.0, 0.0]))
+    for point in ([3.0, -2.0, 0.0], [6.0, 1.0, 0.0], [1.0, -4.5, 0.0]):
+        pixel = camera.project(np.array(point), 1280, 720)
+        assert camera.water_point(*pixel, 1280, 720) == pytest.approx(point, abs=1e-6)
+    assert camera.water_point(640, 719, 1280, 720)[2] == pytest.approx(0.0)
+    assert OrbitCamera(pitch_rad=math.radians(5)).water_point(640, 719.9, 1280, 720) is None   # above the horizon
+
+
+def test_camera_orbit_stays_above_water_and_zoom_is_bounded():
+    camera = OrbitCamera()
+    camera.orbit(0, 10_000)
+    assert camera.eye_m[2] > 0
+    camera.zoom(-100)
+    assert camera.distance_m == pytest.approx(60.0)
+    camera.follow(np.array([10.0, 0.0, -1.0]), dt_s=100.0)
+    assert camera.focus_m == pytest.approx([10.0, 0.0, 0.0])     # focus kept at the surface
+
+
+def test_box_triangles_span_the_rotated_box():
+    quarter_turn_z = np.array([[0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4)]])
+    vertices, normals = sc.box_triangles(np.array([[1.0, 2.0, 3.0]]), quarter_turn_z, np.array([[0.5, 0.1, 0.2]]))
+    assert vertices.shape == (36, 3)
+    assert vertices.min(axis=0) == pytest.approx([0.9, 1.5, 2.8])      # the long x side now lies along y
+    assert vertices.max(axis=0) == pytest.approx([1.1, 2.5, 3.2])
+    assert np.linalg.norm(normals, axis=1) == pytest.approx(np.ones(36))
+    # Every triangle winds counterclockwise seen from outside: its geometric normal matches.
+    tri = vertices.reshape(-1, 3, 3)
+    winding = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    assert (np.einsum("ij,ij->i", winding, normals[::3]) > 0).all()
+
+
+def test_arrow_lines_shaft_and_head():
+    lines = sc.arrow_lines(np.array([0.0, 0.0, 0.0]), np.array([2.0, 0.0, 0.0]))
+    assert lines.shape == (6, 3)
+    assert lines[0] == pytest.approx([0, 0, 0]) and lines[1] == pytest.approx([2, 0, 0])
+    assert lines[3] == pytest.approx([1.5, -0.25, 0.0]) and lines[5] == pytest.approx([1.5, 0.25, 0.0])
+    assert np.isfinite(sc.arrow_lines(np.zeros(3), np.array([0.0, 0.0, 1.0]))).all()   # vertical arrow
+
+
+def test_grid_snaps_to_world_multiples():
+    a, b = sc.grid_lines(np.array([0.3, 0.2, 0.0])), sc.grid_lines(np.array([0.9, -0.7, 0.0]))
+    assert np.array_equal(a, b)          # the grid stays put while the focus moves within a cell
+    assert set(np.round(a[:, 2], 6)) == {-sc.GRID_DEPTH_M}
+
+
+def test_segment_colors_tell_cap_suit_and_sides_apart():
+    colors = sc.segment_colors(("pelvis", "head", "left_hand", "right_hand"))
+    assert colors[1, :3] == pytest.approx(sc.CAP)
+    assert colors[0, :3] == pytest.approx(sc.SUIT)
+    assert colors[2, 0] < colors[3, 0]
+
+
+def test_frame_steps_add_up_exactly():
+    assert sum(frame_steps(k, 480, 30) for k in range(30)) == 480
+    assert sum(frame_steps(k, 480, 7) for k in range(7 * 5)) == 480 * 5
+
+
+@pytest.fixture(scope="module")
+def session():
+    s = SwimSession("breaststroke")
+    yield s
+    s.close()
+
+
+def test_session_fixed_step_clock(session):
+    session.reset()
+    assert session.advance(1 / 60) == 8                      # 480 Hz: eight steps a 60 Hz frame
+    assert session.advance(1.0) == round(MAX_LAG_S * 480)    # a long stall is dropped, not owed
+    assert session.falling_behind
+    session.slow_motion = True
+    assert sum(session.advance(1 / 60) for _ in range(60)) == round(480 * SLOW_MOTION)
+    session.slow_motion, session.paused = False, True
+    assert session.advance(1.0) == 0
+    session.paused = False
+
+
+def test_session_switches_apply_to_the_running_simulation(session):
+    session.reset()
+    session.toggle_layer("cycle")
+    assert not session.sim.controller.layers.cycle
+    session.toggle_layer("palm")
+    assert not session.sim.controller.layers.palm
+    session.toggle_layer("cycle")
+    session.toggle_layer("palm")
+    session.next_current()
+    assert session.sim.medium.current_m_s == (0.0, 0.3, 0.0)
+    session.next_density()
+    assert session.sim.medium.rho_kg_m3 == pytest.approx(1023.3)
+    assert session.sim.fluid.medium is session.sim.medium
+    session.current_index = session.density_index = 0
+    session.step(480)
+    where = session.com_m
+    session.set_stroke("treading_water")
+    assert session.stroke == "treading_water" and session.sim.controller.layers.cycle
+    assert session.com_m[:2] == pytest.approx(where[:2], abs=0.3)    # switched in place
+    session.set_stroke("rest")                                       # no calibration table
+    assert not session.cycle_available and "calibration" in session.message
+    assert not session.sim.controller.layers.cycle
+    session.set_stroke("breaststroke")
+
+
+def test_session_target_and_depth(session):
+    session.reset()
+    session.set_target((4.0, 3.0))
+    assert session.target_m == pytest.approx([4.0, 3.0, -0.3])
+    session.change_target_depth(10.0)
+    assert session.target_m[2] == pytest.approx(-3.0)
+    session.change_target_depth(-10.0)
+    assert session.target_m[2] == pytest.approx(0.0)
+    session.change_target_depth(0.3)
+
+
+def test_session_rejects_bad_input():
+    with pytest.raises(ConfigError, match="unknown stroke"):
+        SwimSession("butterfly")
+    with pytest.raises(ConfigError, match="unknown trajectory"):
+        SwimSession(trajectory="nowhere")
+
+
+def test_hud_lists_the_figures(session):
+    session.reset()
+    session.step(480)
+    text = "\n".join(hud_lines(session, fps=42.0))
+    for word in ("breaststroke", "m/s", "stroke rate", "phase", "weights", "per-cycle on", "palm on", "reach on",
+                 "997.05 kg/m3", "current none", "distance", "real time", "42 FPS"):
+        assert word in text
+    session.paused = True
+    assert "PAUSED" in "\n".join(hud_lines(session, 0.0))
+    session.paused = False
+
+
+def test_frame_writer_png_fallback(tmp_path):
+    writer = FrameWriter(tmp_path / "frames", fps=10)
+    for shade in (0, 128):
+        writer.add(np.full((8, 12, 3), shade, np.uint8))
+    path = writer.close()
+    frames = sorted(path.glob("frame_*.png"))
+    assert [np.asarray(Image.open(f)).mean() for f in frames] == [0, 128]
