@@ -230,7 +230,7 @@ def _cmd_goal(args) -> None:
 
 
 def _cmd_render(args) -> None:
-    from layered_swim.app.render import render
+    from layered_swim.render.headless import render
     from layered_swim.control.layered import Layers
 
     result = render(args.source, args.out, args.seconds, args.fps, _size(args.size), args.stroke, Layers.parse(args.layers),

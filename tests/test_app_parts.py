@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from layered_swim.app import scene as sc
-from layered_swim.app.camera import OrbitCamera, look_at, perspective
-from layered_swim.app.frames import FrameWriter
-from layered_swim.app.hud import hud_lines
-from layered_swim.app.render import frame_steps
-from layered_swim.app.session import MAX_LAG_S, SLOW_MOTION, SwimSession
+from layered_swim.render import scene as sc
+from layered_swim.render.camera import OrbitCamera, look_at, perspective
+from layered_swim.render.frames import FrameWriter
+from layered_swim.render.hud import hud_lines
+from layered_swim.render.headless import frame_steps
+from layered_swim.render.session import MAX_LAG_S, SLOW_MOTION, SwimSession
 from layered_swim.config import ConfigError
 
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from layered_swim.app import scene as sc
+from layered_swim.render import scene as sc
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -46,8 +46,8 @@ def display():
 
 @pytest.fixture
 def window(display, tmp_path):
-    from layered_swim.app.session import SwimSession
-    from layered_swim.app.window import SwimWindow
+    from layered_swim.render.session import SwimSession
+    from layered_swim.render.window import SwimWindow
 
     w = SwimWindow(SwimSession("breaststroke"), 960, 540, capture_dir=tmp_path)
     w.dispatch_events()

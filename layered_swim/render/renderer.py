@@ -8,8 +8,8 @@ import numpy as np
 from pyglet import gl
 from pyglet.graphics.shader import Shader, ShaderProgram
 
-from layered_swim.app import scene as sc
-from layered_swim.app.camera import OrbitCamera, gl_matrix
+from layered_swim.render import scene as sc
+from layered_swim.render.camera import OrbitCamera, gl_matrix
 
 VERTEX_SHADER = """#version 330 core
 in vec3 position;

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from layered_swim.app.scene import Scene
+from layered_swim.render.scene import Scene
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError
 

@@ -1,7 +1,7 @@
 """The interactive window (pyglet 2): the swimmer chases the target you click on the water.
 
 Physics runs on its own fixed step inside ``SwimSession.advance``; pyglet's clock only says how
-much wall time passed. Import this module only with a display (``main.py`` checks first).
+much wall time passed. Import this module only with a display (``app.py`` checks first).
 """
 from __future__ import annotations
 
@@ -15,11 +15,11 @@ from typing import Callable
 import pyglet
 from pyglet.window import key, mouse
 
-from layered_swim.app.camera import OrbitCamera
-from layered_swim.app.frames import FrameWriter, save_png
-from layered_swim.app.hud import hud_lines
-from layered_swim.app.renderer import Renderer, gl_config, read_pixels
-from layered_swim.app.session import SwimSession
+from layered_swim.render.camera import OrbitCamera
+from layered_swim.render.frames import FrameWriter, save_png
+from layered_swim.render.hud import hud_lines
+from layered_swim.render.renderer import Renderer, gl_config, read_pixels
+from layered_swim.render.session import SwimSession
 
 FRAME_INTERVAL_S = 1.0 / 60.0
 VIDEO_FPS = 30.0

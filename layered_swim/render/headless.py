@@ -10,8 +10,8 @@ import math
 import os
 from pathlib import Path
 
-from layered_swim.app.camera import OrbitCamera
-from layered_swim.app.frames import FrameWriter
+from layered_swim.render.camera import OrbitCamera
+from layered_swim.render.frames import FrameWriter
 from layered_swim.config import ConfigError
 from layered_swim.control.layered import Layers
 from layered_swim.sim.simulation import SimulationDiverged
@@ -37,7 +37,7 @@ def render(source: str, out: str | Path, seconds: float | None = None, fps: floa
     os.environ["PYGLET_HEADLESS"] = "1"
     import pyglet
     pyglet.options["headless"] = True
-    from layered_swim.app.renderer import Renderer, gl_config, read_pixels
+    from layered_swim.render.renderer import Renderer, gl_config, read_pixels
 
     window = pyglet.window.Window(width, height, visible=False, config=gl_config())
     writer = FrameWriter(out, fps)
@@ -65,7 +65,7 @@ def _frames(source, seconds, fps, stroke, layers, current_m_s, density_kg_m3):
     """Yields (segment names, frame count) first, then one Scene per frame."""
     path = Path(source)
     if path.is_dir():
-        from layered_swim.app.replay import LogReplay
+        from layered_swim.render.replay import LogReplay
         replay = LogReplay(path)
         duration = replay.duration_s if seconds is None else min(seconds, replay.duration_s)
         total = _count(duration, fps)
@@ -73,7 +73,7 @@ def _frames(source, seconds, fps, stroke, layers, current_m_s, density_kg_m3):
         for k in range(total):
             yield replay.scene(k / fps)
         return
-    from layered_swim.app.session import SwimSession
+    from layered_swim.render.session import SwimSession
     from layered_swim.control.targets import trajectory_path
     try:
         trajectory_path(source)

@@ -1,7 +1,7 @@
 """The HUD text: a session in, lines out (no OpenGL, so it is testable on its own)."""
 from __future__ import annotations
 
-from layered_swim.app.session import SwimSession
+from layered_swim.render.session import SwimSession
 
 
 def hud_lines(session: SwimSession, fps: float, recording: str = "") -> list[str]:

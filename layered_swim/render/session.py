@@ -11,7 +11,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from layered_swim.app.scene import Scene
+from layered_swim.render.scene import Scene
 from layered_swim.control.calibration import CalibrationError
 from layered_swim.control.layered import Layers
 from layered_swim.control.steering import attitude
