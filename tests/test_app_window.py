@@ -188,3 +188,14 @@ def test_bad_arguments_fail_before_any_window(args, words):
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("app.py: error: ") and "Traceback" not in result.stderr
     assert all(w in lines[0] for w in words)
+
+
+def test_readme_lists_every_key(display):
+    from layered_swim.render.window import BINDINGS
+
+    readme = (REPO / "README.md").read_text()
+    table = readme[readme.index("| input | does |"):].split("\n\n")[0]
+    listed = {key.strip() for row in table.splitlines()[2:] for cell in [row.split("|")[1]]
+              for part in cell.split(",") for key in part.split(" / ")}
+    for binding in BINDINGS:
+        assert set(binding.label.split("/")) <= listed, binding.label
