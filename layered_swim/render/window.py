@@ -247,7 +247,7 @@ class SwimWindow(pyglet.window.Window):
     def on_resize(self, width: int, height: int) -> None:
         super().on_resize(width, height)
         self._help.x, self._help.y = width // 2, height // 2
-        self._help_box.width, self._help_box.height = self._help.content_width + 30, self._help.content_height + 30
+        self._help_box.width, self._help_box.height = self._help.width + 30, self._help.content_height + 30
         self._help_box.x = width // 2 - self._help_box.width // 2
         self._help_box.y = height // 2 - self._help_box.height // 2
         self._refresh_hud(force=True)
