@@ -12,7 +12,8 @@ from layered_swim.control.pose import joint_layout, quat_multiply
 from layered_swim.control.rules import arm_indices, rule_offsets
 from layered_swim.control.steering import Attitude, wanted_turns
 from layered_swim.control.stroke import JointKeys, RulesSpec, StrokeSpec, build_stroke, load_stroke, mirrored_keys
-from layered_swim.control.targets import FixedTarget
+from layered_swim.control.policy import Lead, TargetPolicy, TempoControl
+from layered_swim.control.targets import FixedTarget, load_trajectory
 from layered_swim.runs import build_swim
 from layered_swim.sim.simulation import PRONE_QUAT_XYZW
 from layered_swim.sim.world import BodyState
@@ -181,3 +182,21 @@ def test_palm_rule_adds_forward_displacement():
         finally:
             sim.close()
     assert travelled["basic,palm"] >= 1.10 * travelled["basic"]
+
+
+def test_lead_looks_further_ahead_where_the_path_bends():
+    lead = Lead(straight_s=1.5, bend_s=3.0)
+    assert lead.seconds(FixedTarget((3.0, 0.0, -0.3)), 0.0) == pytest.approx(1.5)
+    assert lead.seconds(load_trajectory("straight_line"), 5.0) == pytest.approx(1.5)
+    assert lead.seconds(load_trajectory("circle"), 5.0) > 2.0      # a circle keeps turning
+
+
+def test_policy_asks_for_thrust_only_when_far_and_ahead():
+    mass = np.full(16, 1 / 16)
+    state = BodyState(0.0, np.zeros((16, 3)), np.tile(PRONE_QUAT_XYZW, (16, 1)), np.zeros((16, 3)), np.zeros((16, 3)))
+    choice = lambda point: TargetPolicy(FixedTarget(point), table(), "prone", mass)(0, state, 0.0)  # noqa: E731
+    assert choice((5.0, 0.0, 0.0)).thrust_demand == pytest.approx(1.0)     # far, straight ahead
+    assert choice((0.1, 0.0, 0.0)).thrust_demand == pytest.approx(0.0)     # there already
+    assert choice((-5.0, 0.0, 0.0)).thrust_demand == pytest.approx(0.0)    # behind: turn first
+    near = choice((0.1, 0.0, 0.0))
+    assert near.tempo == pytest.approx(TempoControl().min_tempo)

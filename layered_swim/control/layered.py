@@ -53,6 +53,7 @@ class CycleChoice:
     weights: dict[str, float] = field(default_factory=dict)
     tempo: float = 1.0
     glide: bool = False      # hold the cycle's first pose for one period instead of stroking
+    thrust_demand: float = 1.0   # 0..1: how much more force the rules should seek this cycle
 
 
 class WeightPolicy(Protocol):
@@ -144,7 +145,7 @@ class LayeredController:
         thrust would even it out."""
         forward = quat_rotate(state.quat_xyzw[0], FORWARD_LOCAL[self.stroke.start.posture])
         turning = max(self.choice.weights.get("yaw_left", 0.0), self.choice.weights.get("yaw_right", 0.0))
-        return max(0.0, float(forward @ desired)) ** 2 * max(0.0, 1.0 - turning) ** 3
+        return max(0.0, float(forward @ desired)) ** 2 * max(0.0, 1.0 - turning) ** 3 * self.choice.thrust_demand
 
     def _track_roll(self, state: BodyState) -> None:
         """Accumulate the cycle's mean shoulder roll: a crawl rolls +-30 deg within a cycle, so

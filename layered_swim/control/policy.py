@@ -2,9 +2,9 @@
 
 At each cycle start: where is the target relative to the swimmer (heading error, depth, and the
 shoulder roll averaged over the last cycle against the stroke's own), how much of that to correct
-this cycle, and which
-weights the calibration table says produce those turns. The cycle's tempo slows the stroke near
-the target so the swimmer does not overshoot a slow target.
+this cycle, and which weights the calibration table says produce those turns. The cycle's tempo
+slows the stroke near the target so the swimmer does not overshoot a slow target, and the rules
+are told how much more thrust is wanted.
 """
 from __future__ import annotations
 
@@ -33,31 +33,55 @@ class TempoControl:
     easy_turn_rad: float = math.radians(30.0)
     wide_turn_rad: float = math.radians(90.0)
 
-    def tempo(self, distance_m: float, heading_error_rad: float = 0.0) -> float:
+    def drive(self, distance_m: float, heading_error_rad: float = 0.0) -> float:
+        """How hard to swim, 0 (slowest) to 1 (full tempo)."""
         near = (distance_m - self.near_m) / (self.far_m - self.near_m)
         straight = (self.wide_turn_rad - abs(heading_error_rad)) / (self.wide_turn_rad - self.easy_turn_rad)
-        x = min(1.0, max(0.0, min(near, straight)))
-        return float(self.min_tempo + (1.0 - self.min_tempo) * x)
+        return min(1.0, max(0.0, min(near, straight)))
+
+    def tempo_for(self, drive: float) -> float:
+        return float(self.min_tempo + (1.0 - self.min_tempo) * drive)
+
+
+@dataclass(frozen=True)
+class Lead:
+    """How far ahead in time to aim at a moving target. Where its path runs straight, a short
+    look keeps a sideways error (a cross current's drift) corrected hard; where the path bends,
+    a long one starts the turn early, as turning takes cycles."""
+
+    straight_s: float = 1.5
+    bend_s: float = 3.0
+    full_bend_rad: float = math.radians(60.0)   # the path's change of direction over bend_s that earns all of it
+
+    def seconds(self, target: Target, time_s: float) -> float:
+        now = target.position(time_s + 0.5) - target.position(time_s)
+        later = target.position(time_s + self.bend_s + 0.5) - target.position(time_s + self.bend_s)
+        norms = float(np.linalg.norm(now) * np.linalg.norm(later))
+        bend = math.acos(max(-1.0, min(1.0, float(now @ later) / norms))) if norms > 1e-12 else 0.0
+        return self.straight_s + (self.bend_s - self.straight_s) * min(1.0, bend / self.full_bend_rad)
 
 
 class TargetPolicy:
     def __init__(self, target: Target, table: CalibrationTable, posture: str, mass_fraction: np.ndarray,
-                 gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead_s: float = 2.0):
-        self.target, self.table, self.posture, self.lead_s = target, table, posture, lead_s
+                 gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead: Lead = Lead()):
+        self.target, self.table, self.posture, self.lead = target, table, posture, lead
         self.mass_fraction, self.gains, self.tempo_control = mass_fraction, gains, tempo
         self.last_wanted: dict[str, float] = {}
 
     def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
         position = self.mass_fraction @ state.pos_m
-        # Steer for where a moving target will be a little later: turning takes cycles.
-        target = self.target.position(state.time_s + self.lead_s)
+        target = self.target.position(state.time_s + self.lead.seconds(self.target, state.time_s))
         now = attitude(state.quat_xyzw[0], state.quat_xyzw[2], self.posture)
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); roll
         # averaged over the last cycle (a crawl rolls +-30 deg within it).
         att = Attitude(now.heading_rad, now.pitch_rad, now.roll_rad if mean_roll_rad is None else mean_roll_rad)
         heading_error = wrap_angle(math.atan2(target[1] - position[1], target[0] - position[0]) - att.heading_rad)
         distance = float(np.linalg.norm(self.target.position(state.time_s) - position))
-        tempo = self.tempo_control.tempo(distance, heading_error)
+        drive = self.tempo_control.drive(distance, heading_error)
+        tempo = self.tempo_control.tempo_for(drive)
         self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains, self.table.roll_at(tempo))
         glide = distance < self.tempo_control.glide_within_m and abs(heading_error) < self.tempo_control.easy_turn_rad
-        return CycleChoice({} if glide else self.table.weights_for(self.last_wanted, tempo), tempo, glide)
+        # Near the target, or turning hard, the rules stop seeking more thrust (Yang 4.4: more force
+        # only where more is wanted); else they speed the swimmer past a slow target.
+        return CycleChoice({} if glide else self.table.weights_for(self.last_wanted, tempo), tempo, glide,
+                           thrust_demand=drive)
