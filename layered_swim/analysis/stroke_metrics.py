@@ -1,0 +1,175 @@
+"""Per-cycle stroke metrics from a logged swim: pure functions of the recorded arrays.
+
+``analyze_log`` cuts the settled part of a log into stroke cycles (``cycles.py``) and measures
+each cycle; the helpers above it each compute one quantity and are tested on hand-made
+trajectories. Axes: world z up, surface at z = 0. "Forward" is the horizontal direction the
+centre of mass travelled over the analysed window; the thrust axis is forward for prone strokes
+and straight up for upright ones (treading water pushes the body up, not along).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from layered_swim.analysis.cycles import cycle_means, cycle_starts, resample_cycles
+from layered_swim.analysis.metrics import roll_deg
+from layered_swim.config import ConfigError
+from layered_swim.control.pose import quat_rotate
+from layered_swim.control.steering import FORWARD_LOCAL
+
+PELVIS_LONG_AXIS_LOCAL = np.array([0.0, 0.0, 1.0])
+LIMBS = ("hand_l", "hand_r", "foot_l", "foot_r")
+CYCLE_MARKER = {"prone": "hand_l", "upright": "foot_l"}   # reaches furthest once per cycle
+MIN_CYCLES = 2
+EXCERPT_CYCLES = 6     # cycles shown as time series in the plot of how the swim was cut
+UP = np.array([0.0, 0.0, 1.0])
+
+
+def travel_direction(com_pos_m) -> np.ndarray:
+    """Unit horizontal vector of the net displacement of the centre of mass (T, 3); +x when it
+    did not move horizontally."""
+    d = np.asarray(com_pos_m, dtype=float)[-1] - np.asarray(com_pos_m, dtype=float)[0]
+    d[2] = 0.0
+    norm = np.linalg.norm(d)
+    return d / norm if norm > 1e-9 else np.array([1.0, 0.0, 0.0])
+
+
+def pitch_deg(quat_xyzw, forward_local) -> np.ndarray:
+    """Elevation of a segment's forward axis above the horizontal (head up > 0 for a prone
+    pelvis, leaning back > 0 for an upright one)."""
+    forward = quat_rotate(np.asarray(quat_xyzw, dtype=float), np.asarray(forward_local, dtype=float))
+    return np.degrees(np.arcsin(np.clip(forward[..., 2], -1.0, 1.0)))
+
+
+def reach_along_body_m(marker_pos_m, pelvis_pos_m, pelvis_quat_xyzw) -> np.ndarray:
+    """How far a segment lies along the pelvis long axis (towards the head) from the pelvis."""
+    axis = quat_rotate(np.asarray(pelvis_quat_xyzw, dtype=float), PELVIS_LONG_AXIS_LOCAL)
+    return np.sum((np.asarray(marker_pos_m, dtype=float) - np.asarray(pelvis_pos_m, dtype=float)) * axis, axis=-1)
+
+
+def propulsive_resistive_n(force_n, axis) -> tuple[np.ndarray, np.ndarray]:
+    """Per sample, the sums over segments of the forces' positive and (as magnitudes) negative
+    parts along ``axis``: force_n (T, segments, 3) -> two (T,) arrays, both >= 0."""
+    along = np.asarray(force_n, dtype=float) @ np.asarray(axis, dtype=float)
+    return np.clip(along, 0.0, None).sum(axis=-1), np.clip(-along, 0.0, None).sum(axis=-1)
+
+
+def speed_fluctuation_pct(speed_profiles) -> np.ndarray:
+    """Intracycle speed fluctuation per cycle, +-percent of the cycle's mean speed: half the
+    range over the mean, 100 (max - min) / (2 mean). speed_profiles (cycles, points)."""
+    p = np.asarray(speed_profiles, dtype=float)
+    return 100.0 * (p.max(axis=1) - p.min(axis=1)) / (2.0 * cycle_means(p))
+
+
+def amplitude(profiles) -> np.ndarray:
+    """Half the peak-to-peak range of each cycle (cycles, points) -> (cycles,)."""
+    p = np.asarray(profiles, dtype=float)
+    return 0.5 * (p.max(axis=1) - p.min(axis=1))
+
+
+def mean_power_w(time_s, work_j, starts) -> np.ndarray:
+    """Mean power over each cycle from a running total of work: its change over the cycle."""
+    at = np.interp(starts, time_s, work_j)
+    return np.diff(at) / np.diff(starts)
+
+
+def propelling_efficiency(drag_n, speed_m_s, power_w):
+    """Useful power (overcoming the active drag at the mean speed) over mechanical power."""
+    return drag_n * speed_m_s / power_w
+
+
+@dataclass(frozen=True)
+class SwimmerInfo:
+    segment_names: tuple[str, ...]
+    posture: str              # prone | upright: which segment marks cycles, which axis is thrust
+    period_hint_s: float      # the controller's cycle period, to reject noise crossings
+    settle_s: float           # analyse from here on
+
+
+def _stats(values) -> dict:
+    v = np.asarray(values, dtype=float)
+    return {"mean": float(v.mean()), "sd": float(v.std(ddof=1)) if len(v) > 1 else 0.0}
+
+
+def analyze_log(log: dict, info: SwimmerInfo) -> dict:
+    """Cycles, per-cycle rows, means and spreads, and mean +- SD profiles over the normalised
+    cycle. ``log`` holds the recorder's arrays including ``joint_work_j``."""
+    t = np.asarray(log["time_s"], dtype=float)
+    keep = t >= info.settle_s
+    seg = {name: i for i, name in enumerate(info.segment_names)}
+    pos, quat = log["segment_pos_m"][keep], log["segment_quat_xyzw"][keep]
+    t, com = t[keep], log["com_pos_m"][keep]
+    pelvis, thorax = seg["pelvis"], seg["thorax"]
+    marker = reach_along_body_m(pos[:, seg[CYCLE_MARKER[info.posture]]], pos[:, pelvis], quat[:, pelvis])
+    starts = cycle_starts(t, marker, info.period_hint_s)
+    if len(starts) < MIN_CYCLES + 1:
+        raise ConfigError(f"only {max(len(starts) - 1, 0)} whole stroke cycles after the {info.settle_s:g} s "
+                          f"settle time; swim longer (at least {MIN_CYCLES} cycles are needed)")
+    prone = info.posture == "prone"
+    forward = travel_direction(com)
+    thrust_axis = forward if prone else UP
+    hydro = (log["fluid_force_n"] - log["buoyancy_force_n"])[keep]
+    propulsive, resistive = propulsive_resistive_n(hydro, thrust_axis)
+    limb_force = hydro[:, [seg[name] for name in LIMBS]]
+    work = log["joint_work_j"][keep]
+    series = {
+        "forward_speed_m_s": log["com_vel_m_s"][keep] @ forward,
+        "shoulder_roll_deg": roll_deg(quat[:, thorax]),
+        "hip_roll_deg": roll_deg(quat[:, pelvis]),
+        "pitch_deg": pitch_deg(quat[:, pelvis], FORWARD_LOCAL[info.posture]),
+        "head_top_m": log["head_top_m"][keep],
+        "propulsive_force_n": propulsive,
+        "resistive_force_n": resistive,
+        "joint_power_w": np.gradient(work, t),
+    }
+    for k, name in enumerate(LIMBS):
+        series[f"{name}_thrust_n"] = limb_force[:, k] @ thrust_axis
+        series[f"{name}_force_n"] = np.linalg.norm(limb_force[:, k], axis=1)
+    profiles = {name: resample_cycles(t, values, starts) for name, values in series.items()}
+    means = {name: cycle_means(p) for name, p in profiles.items()}
+
+    duration = np.diff(starts)
+    ends = np.column_stack([np.interp(starts, t, com[:, k]) for k in range(3)])
+    distance = np.diff(ends, axis=0) @ forward
+    rows = {
+        "start_s": starts[:-1], "duration_s": duration, "stroke_rate_cpm": 60.0 / duration,
+        "distance_per_cycle_m": distance, "mean_speed_m_s": distance / duration,
+        "speed_fluctuation_pct": speed_fluctuation_pct(profiles["forward_speed_m_s"]) if prone else None,
+        "shoulder_roll_deg": amplitude(profiles["shoulder_roll_deg"]),
+        "hip_roll_deg": amplitude(profiles["hip_roll_deg"]),
+        "pitch_deg": means["pitch_deg"], "head_top_m": means["head_top_m"],
+        "propulsive_force_n": means["propulsive_force_n"], "resistive_force_n": means["resistive_force_n"],
+        "mechanical_power_w": mean_power_w(t, work, starts),
+        **{f"peak_{name}_force_n": profiles[f"{name}_force_n"].max(axis=1) for name in LIMBS},
+    }
+    rows = {k: v for k, v in rows.items() if v is not None}
+    summary = {name: _stats(values) for name, values in rows.items() if name != "start_s"}
+    for limb in ("hand", "foot"):
+        summary[f"peak_{limb}_force_n"] = _stats(np.maximum(rows[f"peak_{limb}_l_force_n"], rows[f"peak_{limb}_r_force_n"]))
+    speed = summary["mean_speed_m_s"]["mean"]
+    power = summary["mechanical_power_w"]["mean"]
+    drag = summary["resistive_force_n"]["mean"] if prone else None
+    summary.update({
+        "cycles": len(duration),
+        "analysed_s": float(starts[-1] - starts[0]),
+        "travel_direction": forward.tolist(),
+        "thrust_axis": "forward" if prone else "up",
+        "active_drag_n": drag,
+        "active_drag_per_v2_kg_m": drag / speed**2 if prone else None,
+        "propelling_efficiency": propelling_efficiency(drag, speed, power) if prone else None,
+    })
+    return {
+        "summary": summary,
+        "cycles": [{k: float(v[i]) for k, v in rows.items()} for i in range(len(duration))],
+        "profiles": {name: {"mean": p.mean(axis=0).tolist(), "sd": p.std(axis=0, ddof=1).tolist()}
+                     for name, p in profiles.items()},
+        "excerpt": _excerpt(t, series["forward_speed_m_s"], marker, starts),
+    }
+
+
+def _excerpt(t, speed, marker, starts) -> dict:
+    """The first few analysed cycles as time series, for the plot that shows how cycles were cut."""
+    inside = (t >= starts[0]) & (t <= starts[min(EXCERPT_CYCLES, len(starts) - 1)])
+    return {"time_s": t[inside].tolist(), "forward_speed_m_s": speed[inside].tolist(),
+            "cycle_marker_m": marker[inside].tolist(), "starts_s": starts[: EXCERPT_CYCLES + 1].tolist()}
