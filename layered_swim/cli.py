@@ -54,8 +54,7 @@ def _parser() -> argparse.ArgumentParser:
 
     calibrate = sub.add_parser("calibrate", help="measure each perturbation sequence's turn per cycle (Yang 4.3)")
     calibrate.add_argument("--stroke", required=True, help="stroke name or path to a stroke .yaml")
-    calibrate.add_argument("--workers", type=int, default=2, help="parallel simulations (default 2)")
-    calibrate.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _parallel_options(calibrate)
 
     follow = sub.add_parser("follow", help="chase a target moving along a trajectory file")
     follow.add_argument("trajectory", help="trajectory name (see trajectories/) or path to a .yaml")
@@ -90,15 +89,14 @@ def _parser() -> argparse.ArgumentParser:
         command.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     analyze.add_argument("--out", help="output folder (default runs/analyze-<stroke>-<timestamp>)")
     compare.add_argument("--out", help="output folder (default runs/compare-<timestamp>)")
-    compare.add_argument("--workers", type=int, default=2, help="parallel simulations (at most 2)")
-    compare.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _parallel_options(compare)
 
     experiment = sub.add_parser("experiment", help="reproduce one of the papers' experiments (figure + CSV + report)")
     experiment.add_argument("name", help="experiment name; `layered-swim experiment list` lists them")
     experiment.add_argument("--out", help="output folder (default runs/experiment-<name>)")
     experiment.add_argument("--quick", action="store_true", help="fewer and shorter runs, for a first look")
-    experiment.add_argument("--workers", type=int, default=2, help="parallel simulations (at most 2)")
-    experiment.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _parallel_options(experiment)
+    experiment.add_argument("--seed", type=int, default=0, help="seed of the random pushes (perturbation)")
     experiment.add_argument("--json", action="store_true", help="print the experiment's summary as one JSON object")
 
     bench = sub.add_parser("bench", help="time one physics step, bare and through the whole loop")
@@ -106,6 +104,11 @@ def _parser() -> argparse.ArgumentParser:
     bench.add_argument("--seconds", type=float, default=5.0, help="simulated seconds per repeat (default 5)")
     bench.add_argument("--physics-hz", type=int, default=480)
     return p
+
+
+def _parallel_options(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--workers", type=int, default=2, help="parallel simulations (default 2)")
+    command.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
 def _table(rows: list[list[str]], header: list[str] | None = None) -> str:
@@ -284,7 +287,8 @@ def _cmd_compare(args) -> None:
 
 
 def _cmd_experiment(args) -> None:
-    from layered_swim.analysis.experiments import EXPERIMENTS, experiment, run_experiment
+    from layered_swim.analysis.experiments import EXPERIMENTS, experiment
+    from layered_swim.analysis.experiments.runner import run_experiment
 
     if args.name == "list":
         print(_table([[name, module.TITLE] for name, module in EXPERIMENTS.items()], ["experiment", "reproduces"]))
@@ -292,7 +296,7 @@ def _cmd_experiment(args) -> None:
     module = experiment(args.name)
     out = Path(args.out or Path("runs") / f"experiment-{args.name}")
     summary = run_experiment(module, out, quick=args.quick, workers=args.workers,
-                             progress=not args.no_progress and sys.stderr.isatty())
+                             progress=not args.no_progress and sys.stderr.isatty(), seed=args.seed)
     if args.json:
         print(json.dumps({**summary, "out_dir": str(out)}, allow_nan=False))
         return

@@ -11,25 +11,29 @@ from __future__ import annotations
 import numpy as np
 
 PROFILE_POINTS = 101          # samples over the normalised cycle, 0 %, 1 %, ..., 100 %
-HYSTERESIS_STD = 0.2          # a crossing counts once the signal has dipped this far below the midline
+HYSTERESIS_STD = 0.2          # half-width of the trigger band round the midline
 MIN_SEPARATION_PERIODS = 0.5  # crossings closer than this fraction of the expected period are noise
 
 
 def cycle_starts(time_s, signal, period_hint_s: float) -> np.ndarray:
-    """Cycle start times: when ``signal`` rises through its mean (interpolated between samples),
-    each after dipping at least HYSTERESIS_STD standard deviations below it and at least
-    MIN_SEPARATION_PERIODS * ``period_hint_s`` after the previous start."""
+    """Cycle start times: when ``signal`` rises through its mean (interpolated between samples).
+    A Schmitt trigger decides which rises count: the signal must have dipped HYSTERESIS_STD
+    standard deviations below the mean and then climb as far above it, so noise wobbling round
+    the mean counts once; a start also needs MIN_SEPARATION_PERIODS * ``period_hint_s`` since the
+    previous one."""
     t, x = np.asarray(time_s, dtype=float), np.asarray(signal, dtype=float)
-    mid, low = x.mean(), x.mean() - HYSTERESIS_STD * x.std()
-    crossings, armed = [], False
+    mid, band = x.mean(), HYSTERESIS_STD * x.std()
+    starts, armed, rise = [], False, None
     for i in range(1, len(x)):
-        armed = armed or x[i - 1] < low
-        if armed and x[i - 1] < mid <= x[i]:
-            when = t[i - 1] + (mid - x[i - 1]) / (x[i] - x[i - 1]) * (t[i] - t[i - 1])
-            if not crossings or when - crossings[-1] >= MIN_SEPARATION_PERIODS * period_hint_s:
-                crossings.append(when)
-                armed = False
-    return np.array(crossings)
+        if x[i - 1] < mid <= x[i]:
+            rise = t[i - 1] + (mid - x[i - 1]) / (x[i] - x[i - 1]) * (t[i] - t[i - 1])   # latest rise so far
+        if x[i] < mid - band:
+            armed = True
+        elif armed and x[i] > mid + band and rise is not None:
+            if not starts or rise - starts[-1] >= MIN_SEPARATION_PERIODS * period_hint_s:
+                starts.append(rise)
+            armed = False
+    return np.array(starts)
 
 
 def resample_cycles(time_s, values, starts, points: int = PROFILE_POINTS) -> np.ndarray:

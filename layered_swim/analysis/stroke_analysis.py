@@ -7,12 +7,12 @@ plots and report.md.
 """
 from __future__ import annotations
 
-import csv
 import math
 from pathlib import Path
 
 from layered_swim.analysis import plots, report
 from layered_swim.analysis.drag import towed_drag
+from layered_swim.analysis.files import write_csv
 from layered_swim.analysis.reference_ranges import ranges_for
 from layered_swim.analysis.stroke_metrics import SwimmerInfo, analyze_log
 from layered_swim.analysis.sweep import file_sha256, run_sweep
@@ -87,10 +87,10 @@ def write_analysis(result: dict, out_dir: str | Path) -> list[str]:
     _write_json(out / "summary.json", {"stroke": result["stroke"], "posture": result["posture"],
                                        **result["summary"], "comparison": table})
     _write_json(out / "config.json", result["config"])
-    _write_csv(out / "cycles.csv", result["cycles"])
+    write_csv(out / "cycles.csv", result["cycles"])
     profiles = result["profiles"]
     points = len(next(iter(profiles.values()))["mean"])
-    _write_csv(out / "profiles.csv", [
+    write_csv(out / "profiles.csv", [
         {"cycle_pct": 100.0 * i / (points - 1),
          **{f"{name}_{stat}": profiles[name][stat][i] for name in profiles for stat in ("mean", "sd")}}
         for i in range(points)])
@@ -98,13 +98,6 @@ def write_analysis(result: dict, out_dir: str | Path) -> list[str]:
         draw(result, out / name)
     (out / "report.md").write_text(report.analysis_report(result, table, list(PLOTS)))
     return ["summary.json", "config.json", "cycles.csv", "profiles.csv", *PLOTS, "report.md"]
-
-
-def _write_csv(path: Path, rows: list[dict]) -> None:
-    with path.open("w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()} for row in rows)
 
 
 def write_comparison(configs: list[dict], out_dir: str | Path, workers: int = 2, progress: bool = False) -> list[dict]:

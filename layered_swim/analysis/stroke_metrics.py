@@ -42,6 +42,13 @@ def pitch_deg(quat_xyzw, forward_local) -> np.ndarray:
     return np.degrees(np.arcsin(np.clip(forward[..., 2], -1.0, 1.0)))
 
 
+def heading_deg(quat_xyzw, forward_local) -> np.ndarray:
+    """Compass direction of a segment's forward axis seen from above, counterclockwise from +x
+    (a left turn increases it), unwrapped so a turn past 180 deg keeps counting."""
+    forward = quat_rotate(np.asarray(quat_xyzw, dtype=float), np.asarray(forward_local, dtype=float))
+    return np.degrees(np.unwrap(np.arctan2(forward[..., 1], forward[..., 0])))
+
+
 def reach_along_body_m(marker_pos_m, pelvis_pos_m, pelvis_quat_xyzw) -> np.ndarray:
     """How far a segment lies along the pelvis long axis (towards the head) from the pelvis."""
     axis = quat_rotate(np.asarray(pelvis_quat_xyzw, dtype=float), PELVIS_LONG_AXIS_LOCAL)

@@ -2,8 +2,8 @@
 
 A job is a JSON-able configuration dict and a task, a module-level function (picklable) from
 configuration to a JSON-able result. The cache key is a hash of the task's name, the
-configuration and the source of the package (so an edited simulator never serves stale
-results); configurations that depend on files people edit carry those files' hashes
+configuration and the package's source (so an edited simulator never serves stale results;
+modules that only draw or write results are left out); configurations that depend on files people edit carry those files' hashes
 (``file_sha256``). A re-run computes only the keys missing from the cache; results are saved
 as each job finishes, so an interrupted sweep keeps what it had done. Every job is seeded and
 deterministic, so the number of workers never changes a result.
@@ -19,14 +19,21 @@ from pathlib import Path
 from typing import Callable
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
-MAX_WORKERS = 2     # the machines this runs on have two cores, shared
+DEFAULT_WORKERS = 2     # the machines this project runs on have two cores
+
+
+# Modules that only present results: editing a plot or a report must not throw the cache away.
+PRESENTATION_ONLY = {"cli.py", "analysis/plots.py", "analysis/report.py", "analysis/files.py", "analysis/sweep.py",
+                     "analysis/experiments/runner.py"}
 
 
 @lru_cache(maxsize=None)
 def code_sha256() -> str:
-    """Hash of every source and data file of the package (body file included)."""
+    """Hash of every source and data file of the package (body file included) that can change a
+    simulation's result."""
     digest = hashlib.sha256()
-    for path in sorted(p for p in PACKAGE_DIR.rglob("*") if p.suffix in (".py", ".yaml") and p.is_file()):
+    files = (p for p in PACKAGE_DIR.rglob("*") if p.suffix in (".py", ".yaml") and p.is_file())
+    for path in sorted(p for p in files if p.relative_to(PACKAGE_DIR).as_posix() not in PRESENTATION_ONLY):
         digest.update(str(path.relative_to(PACKAGE_DIR)).encode())
         digest.update(path.read_bytes())
     return digest.hexdigest()
@@ -57,7 +64,7 @@ def _store(path: Path, config: dict, result) -> None:
 
 
 def run_sweep(task: Callable[[dict], object], configs: list[dict], cache_dir: str | Path | None = None,
-              workers: int = MAX_WORKERS, progress: bool = False, desc: str = "runs") -> list:
+              workers: int = DEFAULT_WORKERS, progress: bool = False, desc: str = "runs") -> list:
     """``task(config)`` for every configuration, in order; cached ones are read, not run."""
     paths = [Path(cache_dir) / f"{cache_key(task, c)}.json" if cache_dir is not None else None for c in configs]
     results = [_load(p) if p is not None else None for p in paths]
@@ -73,7 +80,7 @@ def run_sweep(task: Callable[[dict], object], configs: list[dict], cache_dir: st
                 _store(paths[i], configs[i], result)
             bar.update(1)
 
-        workers = max(1, min(workers, MAX_WORKERS, len(todo)))
+        workers = max(1, min(workers, len(todo)))
         if workers == 1:
             for i in todo:
                 done(i, task(configs[i]))
