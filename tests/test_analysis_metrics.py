@@ -145,3 +145,11 @@ def test_verdicts_against_the_data_sheet():
     drag = active_drag_range(1.0)
     assert (drag.low, drag.high) == (32.2, 38.0)
     assert "speed_fluctuation_pct" in ranges_for("breaststroke", 0.7) and ranges_for("made_up_stroke", 1.0) == {}
+
+
+def test_the_sample_before_any_force_is_left_out():
+    log = made_up_log()
+    log["fluid_force_n"][0] = np.nan          # as the recorder logs it: nothing applied yet at t = 0
+    result = analyze_log(log, SwimmerInfo(NAMES, "prone", 1.25, settle_s=0.0))
+    assert np.isfinite(result["profiles"]["propulsive_force_n"]["mean"]).all()
+    assert result["summary"]["resistive_force_n"]["mean"] == pytest.approx(50.0)

@@ -11,6 +11,10 @@ def square(config: dict) -> dict:
     return {"x": config["x"], "square": config["x"] ** 2}
 
 
+def cube(config: dict) -> dict:
+    return {"cube": config["x"] ** 3}
+
+
 def test_results_in_order_and_cached(tmp_path):
     CALLS.clear()
     configs = [{"x": x} for x in (3, 1, 2)]
@@ -33,7 +37,7 @@ def test_a_damaged_entry_is_computed_again(tmp_path):
 def test_key_follows_task_and_config():
     assert sweep.cache_key(square, {"x": 1}) == sweep.cache_key(square, {"x": 1})
     assert sweep.cache_key(square, {"x": 1}) != sweep.cache_key(square, {"x": 2})
-    assert sweep.cache_key(square, {"x": 1}) != sweep.cache_key(dict, {"x": 1})
+    assert sweep.cache_key(square, {"x": 1}) != sweep.cache_key(cube, {"x": 1})
 
 
 def test_two_workers_give_the_same_results(tmp_path):

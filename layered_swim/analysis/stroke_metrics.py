@@ -103,76 +103,85 @@ def analyze_log(log: dict, info: SwimmerInfo) -> dict:
     """Cycles, per-cycle rows, means and spreads, and mean +- SD profiles over the normalised
     cycle. ``log`` holds the recorder's arrays including ``joint_work_j``."""
     t = np.asarray(log["time_s"], dtype=float)
-    keep = t >= info.settle_s
+    # Sample 0 has no fluid force yet (NaN): never part of the window, whatever the settle time.
+    keep = (t >= info.settle_s) & np.isfinite(log["fluid_force_n"]).all(axis=(1, 2))
+    window = {name: np.asarray(values)[keep] for name, values in log.items()}
+    t = window["time_s"]
     seg = {name: i for i, name in enumerate(info.segment_names)}
-    pos, quat = log["segment_pos_m"][keep], log["segment_quat_xyzw"][keep]
-    t, com = t[keep], log["com_pos_m"][keep]
-    pelvis, thorax = seg["pelvis"], seg["thorax"]
-    marker = reach_along_body_m(pos[:, seg[CYCLE_MARKER[info.posture]]], pos[:, pelvis], quat[:, pelvis])
+    pos, quat = window["segment_pos_m"], window["segment_quat_xyzw"]
+    marker = reach_along_body_m(pos[:, seg[CYCLE_MARKER[info.posture]]], pos[:, seg["pelvis"]], quat[:, seg["pelvis"]])
     starts = cycle_starts(t, marker, info.period_hint_s)
     if len(starts) < MIN_CYCLES + 1:
         raise ConfigError(f"only {max(len(starts) - 1, 0)} whole stroke cycles after the {info.settle_s:g} s "
                           f"settle time; swim longer (at least {MIN_CYCLES} cycles are needed)")
     prone = info.posture == "prone"
-    forward = travel_direction(com)
-    thrust_axis = forward if prone else UP
-    hydro = (log["fluid_force_n"] - log["buoyancy_force_n"])[keep]
-    propulsive, resistive = propulsive_resistive_n(hydro, thrust_axis)
-    limb_force = hydro[:, [seg[name] for name in LIMBS]]
-    work = log["joint_work_j"][keep]
-    series = {
-        "forward_speed_m_s": log["com_vel_m_s"][keep] @ forward,
-        "shoulder_roll_deg": roll_deg(quat[:, thorax]),
-        "hip_roll_deg": roll_deg(quat[:, pelvis]),
-        "pitch_deg": pitch_deg(quat[:, pelvis], FORWARD_LOCAL[info.posture]),
-        "head_top_m": log["head_top_m"][keep],
-        "propulsive_force_n": propulsive,
-        "resistive_force_n": resistive,
-        "joint_power_w": np.gradient(work, t),
-    }
-    for k, name in enumerate(LIMBS):
-        series[f"{name}_thrust_n"] = limb_force[:, k] @ thrust_axis
-        series[f"{name}_force_n"] = np.linalg.norm(limb_force[:, k], axis=1)
+    forward = travel_direction(window["com_pos_m"])
+    series = _series(window, seg, info.posture, forward, forward if prone else UP)
     profiles = {name: resample_cycles(t, values, starts) for name, values in series.items()}
-    means = {name: cycle_means(p) for name, p in profiles.items()}
-
-    duration = np.diff(starts)
-    ends = np.column_stack([np.interp(starts, t, com[:, k]) for k in range(3)])
-    distance = np.diff(ends, axis=0) @ forward
-    rows = {
-        "start_s": starts[:-1], "duration_s": duration, "stroke_rate_cpm": 60.0 / duration,
-        "distance_per_cycle_m": distance, "mean_speed_m_s": distance / duration,
-        "speed_fluctuation_pct": speed_fluctuation_pct(profiles["forward_speed_m_s"]) if prone else None,
-        "shoulder_roll_deg": amplitude(profiles["shoulder_roll_deg"]),
-        "hip_roll_deg": amplitude(profiles["hip_roll_deg"]),
-        "pitch_deg": means["pitch_deg"], "head_top_m": means["head_top_m"],
-        "propulsive_force_n": means["propulsive_force_n"], "resistive_force_n": means["resistive_force_n"],
-        "mechanical_power_w": mean_power_w(t, work, starts),
-        **{f"peak_{name}_force_n": profiles[f"{name}_force_n"].max(axis=1) for name in LIMBS},
-    }
-    rows = {k: v for k, v in rows.items() if v is not None}
+    rows = _cycle_rows(t, window, starts, forward, profiles, prone)
     summary = {name: _stats(values) for name, values in rows.items() if name != "start_s"}
     for limb in ("hand", "foot"):
         summary[f"peak_{limb}_force_n"] = _stats(np.maximum(rows[f"peak_{limb}_l_force_n"], rows[f"peak_{limb}_r_force_n"]))
     speed = summary["mean_speed_m_s"]["mean"]
-    power = summary["mechanical_power_w"]["mean"]
     drag = summary["resistive_force_n"]["mean"] if prone else None
     summary.update({
-        "cycles": len(duration),
+        "cycles": len(starts) - 1,
         "analysed_s": float(starts[-1] - starts[0]),
         "travel_direction": forward.tolist(),
         "thrust_axis": "forward" if prone else "up",
         "active_drag_n": drag,
         "active_drag_per_v2_kg_m": drag / speed**2 if prone else None,
-        "propelling_efficiency": propelling_efficiency(drag, speed, power) if prone else None,
+        "propelling_efficiency": propelling_efficiency(drag, speed, summary["mechanical_power_w"]["mean"]) if prone else None,
     })
     return {
         "summary": summary,
-        "cycles": [{k: float(v[i]) for k, v in rows.items()} for i in range(len(duration))],
+        "cycles": [{k: float(v[i]) for k, v in rows.items()} for i in range(len(starts) - 1)],
         "profiles": {name: {"mean": p.mean(axis=0).tolist(), "sd": p.std(axis=0, ddof=1).tolist()}
                      for name, p in profiles.items()},
         "excerpt": _excerpt(t, series["forward_speed_m_s"], marker, starts),
     }
+
+
+def _series(window: dict, seg: dict, posture: str, forward: np.ndarray, thrust_axis: np.ndarray) -> dict:
+    """Every per-sample quantity that gets a profile over the cycle."""
+    quat = window["segment_quat_xyzw"]
+    hydro = window["fluid_force_n"] - window["buoyancy_force_n"]
+    propulsive, resistive = propulsive_resistive_n(hydro, thrust_axis)
+    series = {
+        "forward_speed_m_s": window["com_vel_m_s"] @ forward,
+        "shoulder_roll_deg": roll_deg(quat[:, seg["thorax"]]),
+        "hip_roll_deg": roll_deg(quat[:, seg["pelvis"]]),
+        "pitch_deg": pitch_deg(quat[:, seg["pelvis"]], FORWARD_LOCAL[posture]),
+        "head_top_m": window["head_top_m"],
+        "propulsive_force_n": propulsive,
+        "resistive_force_n": resistive,
+        "joint_power_w": np.gradient(window["joint_work_j"], window["time_s"]),
+    }
+    for name in LIMBS:
+        series[f"{name}_thrust_n"] = hydro[:, seg[name]] @ thrust_axis
+        series[f"{name}_force_n"] = np.linalg.norm(hydro[:, seg[name]], axis=1)
+    return series
+
+
+def _cycle_rows(t, window: dict, starts, forward, profiles: dict, prone: bool) -> dict:
+    """One value per cycle for every per-cycle quantity (arrays of length cycles)."""
+    means = {name: cycle_means(p) for name, p in profiles.items()}
+    duration = np.diff(starts)
+    com_at_starts = np.column_stack([np.interp(starts, t, window["com_pos_m"][:, k]) for k in range(3)])
+    distance = np.diff(com_at_starts, axis=0) @ forward
+    rows = {
+        "start_s": starts[:-1], "duration_s": duration, "stroke_rate_cpm": 60.0 / duration,
+        "distance_per_cycle_m": distance, "mean_speed_m_s": distance / duration,
+        "shoulder_roll_deg": amplitude(profiles["shoulder_roll_deg"]),
+        "hip_roll_deg": amplitude(profiles["hip_roll_deg"]),
+        "pitch_deg": means["pitch_deg"], "head_top_m": means["head_top_m"],
+        "propulsive_force_n": means["propulsive_force_n"], "resistive_force_n": means["resistive_force_n"],
+        "mechanical_power_w": mean_power_w(t, window["joint_work_j"], starts),
+        **{f"peak_{name}_force_n": profiles[f"{name}_force_n"].max(axis=1) for name in LIMBS},
+    }
+    if prone:    # an upright swimmer hardly travels: its speed fluctuation is noise over nothing
+        rows["speed_fluctuation_pct"] = speed_fluctuation_pct(profiles["forward_speed_m_s"])
+    return rows
 
 
 def _excerpt(t, speed, marker, starts) -> dict:

@@ -2,15 +2,16 @@
 
 A job is a JSON-able configuration dict and a task, a module-level function (picklable) from
 configuration to a JSON-able result. The cache key is a hash of the task's name, the
-configuration and the package's source (so an edited simulator never serves stale results;
-modules that only draw or write results are left out); configurations that depend on files people edit carry those files' hashes
-(``file_sha256``). A re-run computes only the keys missing from the cache; results are saved
+configuration, the task's own module and the package's other source (so an edited simulator
+never serves stale results; modules that only draw or write results are left out).
+Configurations that depend on files people edit carry those files' hashes (``file_sha256``). A re-run computes only the keys missing from the cache; results are saved
 as each job finishes, so an interrupted sweep keeps what it had done. Every job is seeded and
 deterministic, so the number of workers never changes a result.
 """
 from __future__ import annotations
 
 import hashlib
+import inspect
 import json
 import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -20,23 +21,28 @@ from typing import Callable
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 DEFAULT_WORKERS = 2     # the machines this project runs on have two cores
-
-
 # Modules that only present results: editing a plot or a report must not throw the cache away.
-PRESENTATION_ONLY = {"cli.py", "analysis/plots.py", "analysis/report.py", "analysis/files.py", "analysis/sweep.py",
-                     "analysis/experiments/runner.py"}
+PRESENTATION_ONLY = {"cli.py", "analysis/plots.py", "analysis/report.py", "analysis/files.py", "analysis/sweep.py"}
+# One module per experiment: each task's own module joins its key, so editing one experiment
+# recomputes that experiment only.
+TASK_MODULES = "analysis/experiments/"
 
 
 @lru_cache(maxsize=None)
 def code_sha256() -> str:
-    """Hash of every source and data file of the package (body file included) that can change a
-    simulation's result."""
+    """Hash of every source and data file of the package (body file included) that can change
+    any simulation's result."""
     digest = hashlib.sha256()
     files = (p for p in PACKAGE_DIR.rglob("*") if p.suffix in (".py", ".yaml") and p.is_file())
-    for path in sorted(p for p in files if p.relative_to(PACKAGE_DIR).as_posix() not in PRESENTATION_ONLY):
+    shared = (p for p in files if not _presentation_or_task(p.relative_to(PACKAGE_DIR).as_posix()))
+    for path in sorted(shared):
         digest.update(str(path.relative_to(PACKAGE_DIR)).encode())
         digest.update(path.read_bytes())
     return digest.hexdigest()
+
+
+def _presentation_or_task(relative: str) -> bool:
+    return relative in PRESENTATION_ONLY or relative.startswith(TASK_MODULES)
 
 
 def file_sha256(path: str | Path) -> str:
@@ -44,8 +50,10 @@ def file_sha256(path: str | Path) -> str:
 
 
 def cache_key(task: Callable, config: dict) -> str:
-    text = json.dumps({"task": f"{task.__module__}.{task.__qualname__}", "config": config, "code": code_sha256()},
-                      sort_keys=True)
+    """Hash of the task's name and module source, the configuration and the shared code."""
+    module = file_sha256(inspect.getsourcefile(task))
+    text = json.dumps({"task": f"{task.__module__}.{task.__qualname__}", "module": module, "config": config,
+                       "code": code_sha256()}, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 

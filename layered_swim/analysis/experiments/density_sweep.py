@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib.ticker import FormatStrFormatter
 
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
@@ -31,6 +32,7 @@ SETTLE_S = 5.0
 FAIL_DISTANCE_M = 2.0      # tracking fails: mean distance to the target over the run's second half above this
 SWIM_SUCCESS_KG_M3 = (920.0, 1500.0)
 TARGET_DEPTH_M = 0.3       # the straight_line trajectory's depth
+DEPTH_TICKS_M = (-0.5, 0.0, 0.5, 1.0, 3.0, 10.0, 30.0, 100.0, 300.0)
 
 
 def configs(quick: bool, seed: int) -> list[dict]:
@@ -74,11 +76,15 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
         ax.axvline(fresh, color="C0", linestyle=":", linewidth=1.0, label="fresh water")
         ax.set_xlabel("fluid density (kg/m^3)")
     values = lambda key: np.array([r.get(key, np.nan) for r in results])   # noqa: E731
-    depth_ax.plot(rho, values("depth_m"), "o-", color="k")
+    depth = values("depth_m")
+    depth_ax.plot(rho, depth, "o-", color="k")
     depth_ax.axhline(TARGET_DEPTH_M, color="C1", linestyle="--", linewidth=0.8, label="target depth")
     depth_ax.axhline(0.0, color="C0", linewidth=0.8, label="surface")
     depth_ax.set_yscale("symlog", linthresh=1.0)      # from riding on the surface to sinking tens of metres
-    depth_ax.invert_yaxis()
+    deepest = max(1.0, float(np.nanmax(depth)))
+    depth_ax.set_ylim(1.5 * deepest, -0.5)             # deeper is lower
+    depth_ax.set_yticks([d for d in DEPTH_TICKS_M if d <= 1.5 * deepest])
+    depth_ax.yaxis.set_major_formatter(FormatStrFormatter("%g"))
     depth_ax.set_ylabel("mean depth of the centre of mass (m)")
     depth_ax.set_title(f"{STROKE} following a target moving at 0.5 m/s, 0.3 m deep")
     depth_ax.legend(loc="best", fontsize="small")
@@ -111,7 +117,8 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
         where = "at every density here" if not failing else f"only in {'denser' if dense_fail else 'lighter'} fluid"
         differs = f"Yang's swimmer struggles at both ends of the range; ours fails {where}."
     setting = (f"{STROKE}, all three layers, following `{TRAJECTORY}` for {configs[0]['seconds']:g} s at each density "
-               "(fresh water's viscosity); depth averaged after the first 5 s.")
+               "(fresh water's viscosity); depth averaged after the first 5 s. Open water with no floor: in a fluid "
+               "much lighter than the body it sinks freely.")
     return Outcome(ours, setting, differs, {"by_density": [{"density_kg_m3": c["density_kg_m3"], **{
         k: r.get(k) for k in ("depth_m", "mean_distance_m", "late_distance_m", "final_distance_m", "diverged")},
         "tracking_fails": fails(r)} for c, r in zip(configs, results)]})

@@ -65,9 +65,9 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
     (tw_off, tw_on), (bs_off, bs_on) = tuple(tw), tuple(bs)
     gain = 100.0 * (bs_on - bs_off) / abs(bs_off)
     helps_treading = tw_on > tw_off
-    ours = (f"Treading water: the pelvis ends {tw_on:+.2f} m forward with the palm rule against {tw_off:+.2f} m "
-            f"without it after {seconds:g} s ({'more' if helps_treading else 'no more'} forward propulsion). "
-            f"Breaststroke: {bs_on:.1f} m against {bs_off:.1f} m, {gain:+.0f} % with the rule.")
+    ours = (f"Treading water: in {seconds:g} s the pelvis moves {tw_on:+.2f} m along the direction of the target with "
+            f"the palm rule and {tw_off:+.2f} m without it ({'a gain' if helps_treading else 'no gain'}). "
+            f"Breaststroke: {bs_on:.1f} m with the rule against {bs_off:.1f} m without, {gain:+.0f} %.")
     differs = None if helps_treading else (
         "Our treading-water stroke does not reproduce the paper's gain. Its hands scull mostly sideways (left hand "
         "speed, RMS over 10 s: 0.89 m/s across the body, 0.40 m/s fore-aft, 0.22 m/s vertical), so little of the "

@@ -152,6 +152,7 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
         f"{d} - " + (f"back on track after every push up to {max(p[0] for p in impulses[d]):g} mg" if lost[d] is None
                      else f"not back by the end from {lost[d]:g} mg on")
         for d in impulses) + ". At 2 mg: " + ", ".join(
+        f"{d} never off track ({p[3]:.1f} m at worst)" if p[3] <= threshold else
         f"{d} {p[3]:.1f} m off at worst, " + (f"back in {p[2]:.1f} s" if p[1] else "not back")
         for d, p in at_limit.items()) + f". Random pushes: mean distance to the target {quiet_mean:.2f} m unpushed, "
         + ", ".join(f"{m:.2f} m at {f:g} N" for f, m in randoms)
@@ -163,10 +164,12 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
                f"every {RANDOM_HOLD_S:g} s (seeded). On track = within the unperturbed run's largest distance to the "
                f"target after {RANDOM_FROM_S:g} s ({threshold - BACK_ON_TRACK_M:.2f} m) plus {BACK_ON_TRACK_M:g} m; the "
                "recovery time runs from the push to the first return on track after the largest excursion.")
+    ranked = sorted(at_limit, key=lambda d: at_limit[d][3], reverse=True)
     differs = ("SWIM reports freestyle goal reaching; our front crawl cannot follow a target for long under the "
                "per-cycle layer (README, known gaps), so breaststroke following a line stands in, and SWIM does not say "
                "how long its impulses last (ours: 0.1 s). SWIM finds backward and vertical pushes the most disruptive; "
-               "for our swimmer sideways pushes are: they turn it away from the line and it swims a wide loop back.")
+               "ranked by how far a 2 mg push throws ours off: " + ", ".join(
+                   f"{d} {at_limit[d][3]:.1f} m" for d in ranked) + ".")
     numbers = {"on_track_threshold_m": threshold, "not_back_from_mg": lost, "random": [
         {"force_n": f, "mean_distance_m": m} for f, m in randoms], "unpushed_mean_distance_m": quiet_mean}
     return Outcome(ours, setting, differs, numbers)
