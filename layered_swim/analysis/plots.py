@@ -86,8 +86,9 @@ def propulsion_figure(result: dict, path: Path) -> None:
     profiles = result["profiles"]
     fig, axes = figure(2, 1)
     top, bottom = axes[0, 0], axes[1, 0]
-    band(top, profiles["propulsive_force_n"], "propulsive (segments pushed ahead)", color="C2")
-    band(top, profiles["resistive_force_n"], "resistive (segments held back)", scale=-1.0, color="C3")
+    ahead, back = ("pushed ahead", "held back") if result["summary"]["thrust_axis"] == "forward" else ("pushed up", "pushed down")
+    band(top, profiles["propulsive_force_n"], f"propulsive (segments {ahead})", color="C2")
+    band(top, profiles["resistive_force_n"], f"resistive (segments {back})", scale=-1.0, color="C3")
     net = np.asarray(profiles["propulsive_force_n"]["mean"]) - np.asarray(profiles["resistive_force_n"]["mean"])
     top.plot(np.linspace(0.0, 100.0, len(net)), net, color="k", linewidth=1.0, label="net")
     top.axhline(0.0, color="k", linewidth=0.6)

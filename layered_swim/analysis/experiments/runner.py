@@ -13,6 +13,7 @@ from pathlib import Path
 
 from layered_swim.analysis import report
 from layered_swim.analysis.sweep import run_sweep
+from layered_swim.config import ConfigError
 from layered_swim.runs import _write_json, versions
 
 
@@ -26,6 +27,8 @@ class Outcome:
 
 def run_experiment(module, out_dir: str | Path, quick: bool = False, workers: int = 2, progress: bool = False,
                    seed: int = 0) -> dict:
+    if not isinstance(seed, int) or seed < 0:
+        raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     configs = module.configs(quick, seed)
