@@ -112,8 +112,9 @@ def analyze_log(log: dict, info: SwimmerInfo) -> dict:
     marker = reach_along_body_m(pos[:, seg[CYCLE_MARKER[info.posture]]], pos[:, seg["pelvis"]], quat[:, seg["pelvis"]])
     starts = cycle_starts(t, marker, info.period_hint_s)
     if len(starts) < MIN_CYCLES + 1:
-        raise ConfigError(f"only {max(len(starts) - 1, 0)} whole stroke cycles after the {info.settle_s:g} s "
-                          f"settle time; swim longer (at least {MIN_CYCLES} cycles are needed)")
+        raise ConfigError(f"only {max(len(starts) - 1, 0)} whole stroke cycles after the {info.settle_s:g} s settle "
+                          f"time (a cycle is one rise and fall of the {CYCLE_MARKER[info.posture]}'s reach along the "
+                          f"body); at least {MIN_CYCLES} are needed: swim longer, or the stroke does not cycle")
     prone = info.posture == "prone"
     forward = travel_direction(window["com_pos_m"])
     series = _series(window, seg, info.posture, forward, forward if prone else UP)
