@@ -54,8 +54,7 @@ def _parser() -> argparse.ArgumentParser:
 
     calibrate = sub.add_parser("calibrate", help="measure each perturbation sequence's turn per cycle (Yang 4.3)")
     calibrate.add_argument("--stroke", required=True, help="stroke name or path to a stroke .yaml")
-    calibrate.add_argument("--workers", type=int, default=2, help="parallel simulations (default 2)")
-    calibrate.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _parallel_options(calibrate)
 
     follow = sub.add_parser("follow", help="chase a target moving along a trajectory file")
     follow.add_argument("trajectory", help="trajectory name (see trajectories/) or path to a .yaml")
@@ -87,11 +86,42 @@ def _parser() -> argparse.ArgumentParser:
     render.add_argument("--forces", action="store_true", help="draw the per-segment fluid-force arrows")
     render.add_argument("--no-progress", action="store_true", help="no progress bar")
 
+    analyze = sub.add_parser("analyze", help="swim steadily and report per-cycle stroke metrics, plots and a report")
+    analyze.add_argument("--stroke", required=True, help="stroke name (see `strokes`) or path to a stroke .yaml")
+    compare = sub.add_parser("compare", help="analyze several strokes and report them side by side")
+    compare.add_argument("--strokes", required=True, metavar="A,B,...", help="comma-separated stroke names")
+    for command in (analyze, compare):
+        command.add_argument("--seconds", type=float, default=60.0, help="simulated seconds (default 60)")
+        command.add_argument("--settle", type=float, default=5.0, metavar="S", help="seconds left out at the start (default 5)")
+        medium = command.add_mutually_exclusive_group()
+        medium.add_argument("--density", type=float, metavar="KG_M3", help="water density (fresh water's viscosity)")
+        medium.add_argument("--fluid", choices=("fresh_water", "seawater"), default="fresh_water")
+        command.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
+        command.add_argument("--seed", type=int, default=0)
+        command.add_argument("--physics-hz", type=int, default=480)
+        command.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    analyze.add_argument("--out", help="output folder (default runs/analyze-<stroke>-<timestamp>)")
+    compare.add_argument("--out", help="output folder (default runs/compare-<timestamp>)")
+    _parallel_options(compare)
+
+    experiment = sub.add_parser("experiment", help="reproduce one of the papers' experiments (figure + CSV + report)")
+    experiment.add_argument("name", help="experiment name; `layered-swim experiment list` lists them")
+    experiment.add_argument("--out", help="output folder (default runs/experiment-<name>)")
+    experiment.add_argument("--quick", action="store_true", help="fewer and shorter runs, for a first look")
+    _parallel_options(experiment)
+    experiment.add_argument("--seed", type=int, default=0, help="seed of the random pushes (perturbation)")
+    experiment.add_argument("--json", action="store_true", help="print the experiment's summary as one JSON object")
+
     bench = sub.add_parser("bench", help="time one physics step, bare and through the whole loop")
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0, help="simulated seconds per repeat (default 5)")
     bench.add_argument("--physics-hz", type=int, default=480)
     return p
+
+
+def _parallel_options(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--workers", type=int, default=2, help="parallel simulations (default 2)")
+    command.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
 def _table(rows: list[list[str]], header: list[str] | None = None) -> str:
@@ -241,8 +271,79 @@ def _cmd_render(args) -> None:
     print(f"wrote {result['frames']} frames to {result['out']}")
 
 
+def _analysis_config(args, stroke: str) -> dict:
+    from layered_swim.analysis.stroke_analysis import analysis_config
+
+    return analysis_config(stroke, args.seconds, args.density, _vector(args.current, "--current"),
+                           args.fluid, args.settle, args.seed, args.physics_hz)
+
+
+def _summary_rows(result: dict) -> list[list[str]]:
+    from layered_swim.analysis.report import QUANTITIES, fmt
+
+    rows = []
+    for name, (text, unit, _) in QUANTITIES.items():
+        value = result["summary"].get(name)
+        if value is not None:
+            rows.append([text, fmt(name, value["mean"] if isinstance(value, dict) else value), unit])
+    return rows
+
+
+def _cmd_analyze(args) -> None:
+    from layered_swim.analysis.stroke_analysis import analyze_stroke, write_analysis
+
+    config = _analysis_config(args, args.stroke)
+    out = Path(args.out or Path("runs") / f"analyze-{Path(args.stroke).stem}-{time.strftime('%Y%m%d-%H%M%S')}")
+    result = analyze_stroke(config, progress=not args.json and sys.stderr.isatty())
+    files = write_analysis(result, out)
+    if args.json:
+        print(json.dumps({"stroke": result["stroke"], **result["summary"], "out_dir": str(out)}, allow_nan=False))
+        return
+    print(_table(_summary_rows(result), ["quantity", "mean", "unit"]))
+    print(f"\nwrote {', '.join(files)} to {out}")
+
+
+def _cmd_compare(args) -> None:
+    from layered_swim.analysis.stroke_analysis import write_comparison
+    from layered_swim.config import ConfigError
+
+    strokes = [s.strip() for s in args.strokes.split(",") if s.strip()]
+    if not strokes or len(set(strokes)) != len(strokes):
+        raise ConfigError(f"--strokes must name one or more different strokes, got '{args.strokes}'")
+    configs = [_analysis_config(args, stroke) for stroke in strokes]
+    out = Path(args.out or Path("runs") / f"compare-{time.strftime('%Y%m%d-%H%M%S')}")
+    results = write_comparison(configs, out, args.workers, progress=not args.no_progress and sys.stderr.isatty())
+    if args.json:
+        print(json.dumps({r["stroke"]: r["summary"] for r in results} | {"out_dir": str(out)}, allow_nan=False))
+        return
+    names = [r["stroke"] for r in results]
+    by_name = [dict((row[0], row[1]) for row in _summary_rows(r)) for r in results]
+    labels = list(dict.fromkeys(label for rows in by_name for label in rows))
+    print(_table([[label] + [rows.get(label, "-") for rows in by_name] for label in labels], ["quantity"] + names))
+    print(f"\nwrote report.md, compare_profiles.png and one folder per stroke to {out}")
+
+
+def _cmd_experiment(args) -> None:
+    from layered_swim.analysis.experiments import EXPERIMENTS, experiment
+    from layered_swim.analysis.experiments.runner import run_experiment
+
+    if args.name == "list":
+        print(_table([[name, module.TITLE] for name, module in EXPERIMENTS.items()], ["experiment", "reproduces"]))
+        return
+    module = experiment(args.name)
+    out = Path(args.out or Path("runs") / f"experiment-{args.name}")
+    summary = run_experiment(module, out, quick=args.quick, workers=args.workers,
+                             progress=not args.no_progress and sys.stderr.isatty(), seed=args.seed)
+    if args.json:
+        print(json.dumps({**summary, "out_dir": str(out)}, allow_nan=False))
+        return
+    print(summary["ours"])
+    print(f"\nwrote {', '.join(summary['files'])} to {out}")
+
+
 COMMANDS = {"run": _cmd_run, "strokes": _cmd_strokes, "validate": _cmd_validate, "bench": _cmd_bench,
-            "calibrate": _cmd_calibrate, "follow": _cmd_follow, "goal": _cmd_goal, "render": _cmd_render}
+            "calibrate": _cmd_calibrate, "follow": _cmd_follow, "goal": _cmd_goal, "analyze": _cmd_analyze,
+            "compare": _cmd_compare, "experiment": _cmd_experiment, "render": _cmd_render}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -109,9 +109,13 @@ def resolved_config(setup: SwimSetup, arguments: dict, log_hz: int) -> dict:
         "control_hz": sim.config.control_hz,
         "log_hz": log_hz,
         "cycles_per_s": sim.controller.cycles_per_s,
-        "versions": {"layered_swim": package_version(), "python": platform.python_version(),
-                     "numpy": np.__version__, "pybullet": metadata.version("pybullet")},
+        "versions": versions(),
     }
+
+
+def versions() -> dict:
+    return {"layered_swim": package_version(), "python": platform.python_version(),
+            "numpy": np.__version__, "pybullet": metadata.version("pybullet")}
 
 
 def default_out_dir(stroke: str, root: Path = Path("runs")) -> Path:

@@ -41,9 +41,11 @@ class Track:
                 "roll_rad": np.array(self.roll_rad)}
 
 
-def _swim_toward(target: Target, stroke: str, seconds: float, layers: Layers, current, density,
-                 start_xy=(0.0, 0.0), start_speed=None, tempo: TempoControl | None = None,
-                 recorder_dir: Path | None = None) -> tuple[Track, dict]:
+def swim_toward(target: Target, stroke: str, seconds: float, layers: Layers, current, density,
+                start_xy=(0.0, 0.0), start_speed=None, tempo: TempoControl | None = None,
+                recorder_dir: Path | None = None, on_step=None) -> tuple[Track, dict]:
+    """Swim toward ``target`` and track swimmer and target at TRACK_HZ; ``on_step(sim)``, when
+    given, runs after every physics step (experiments push the swimmer from there)."""
     setup = build_swim(stroke, medium=make_medium(density_kg_m3=density).with_(current_m_s=tuple(current)),
                        target=target, layers=layers, tempo_control=tempo)
     sim, start = setup.sim, setup.stroke.start
@@ -70,6 +72,8 @@ def _swim_toward(target: Target, stroke: str, seconds: float, layers: Layers, cu
     def every_step(s) -> None:
         if recorder is not None:
             recorder(s)
+        if on_step is not None:
+            on_step(s)
         sample(s)
 
     try:
@@ -97,7 +101,7 @@ def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = L
     out = Path(out_dir) if out_dir is not None else None
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
-    track, info = _swim_toward(target, stroke, seconds, layers, current, density, recorder_dir=out)
+    track, info = swim_toward(target, stroke, seconds, layers, current, density, recorder_dir=out)
     result = {"trajectory": target.name, "stroke": stroke, "layers": layers.describe(),
               "current_m_s": list(current), "seconds": seconds, **tracking_metrics(track)}
     if target.kind == "line":
@@ -130,22 +134,27 @@ class ScheduledGoal:
         return np.array([bench.goal_position(self.task, t) for t in np.linspace(0.0, self.task.duration_s, n)])
 
 
+GOAL_METRICS = ("pos_m", "prog", "dev_m", "roll_deg")
 GOAL_TEMPO = TempoControl(min_tempo=0.3, near_m=0.2, far_m=1.0)   # slow strokes: the goal line is slow
+
+
+def goal_episode(task: bench.GoalTask, stroke: str, current=(0.0, 0.0, 0.0), layers: Layers = Layers(),
+                 on_step=None) -> tuple[dict, Track]:
+    """One goal-reaching episode: Pos, Prog, Dev and Roll, and the track they come from."""
+    period_s = load_stroke(stroke, joint_layout(load_body())).period_s   # sets the intermediate-goal lead
+    target = ScheduledGoal(task, lead_s=period_s / 2)
+    track, _ = swim_toward(target, stroke, task.duration_s, layers, current, None, start_xy=tuple(task.start_m[:2]),
+                           start_speed=task.speed_m_s, tempo=GOAL_TEMPO, on_step=on_step)
+    a = track.arrays()
+    metrics = bench.episode_metrics(task, a["track_time_s"], a["swimmer_m"], np.degrees(a["roll_rad"]),
+                                    bench.ROLL_TOLERANCE_DEG.get(stroke, 45.0))
+    return {"goal_m": [float(v) for v in task.goal_m], **{k: metrics[k] for k in GOAL_METRICS}}, track
 
 
 def goal_run(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layers = Layers()) -> dict:
     pool = bench.pool(pool_name)
-    period_s = load_stroke(stroke, joint_layout(load_body())).period_s   # sets the intermediate-goal lead
-    per_goal = []
-    for task in bench.goal_tasks(pool):
-        target = ScheduledGoal(task, lead_s=period_s / 2)
-        track, _ = _swim_toward(target, stroke, task.duration_s, layers, current, None,
-                                start_xy=tuple(task.start_m[:2]), start_speed=task.speed_m_s, tempo=GOAL_TEMPO)
-        a = track.arrays()
-        metrics = bench.episode_metrics(task, a["track_time_s"], a["swimmer_m"], np.degrees(a["roll_rad"]),
-                                        bench.ROLL_TOLERANCE_DEG.get(stroke, 45.0))
-        per_goal.append({"goal_m": [float(v) for v in task.goal_m], **{k: metrics[k] for k in ("pos_m", "prog", "dev_m", "roll_deg")}})
-    mean = {k: float(np.mean([g[k] for g in per_goal])) for k in ("pos_m", "prog", "dev_m", "roll_deg")}
+    per_goal = [goal_episode(task, stroke, current, layers)[0] for task in bench.goal_tasks(pool)]
+    mean = {k: float(np.mean([g[k] for g in per_goal])) for k in GOAL_METRICS}
     return {"pool": pool_name, "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
             **mean, "goals": per_goal, "swim_published": bench.SWIM_PUBLISHED.get(pool_name)}
 

@@ -134,7 +134,8 @@ class LayeredController:
         if progress >= 1.0 or not self._previous_weights:
             return self.choice.weights
         ease = progress * progress * (3.0 - 2.0 * progress)
-        names = set(self.choice.weights) | set(self._previous_weights)
+        # A fixed order: the offsets are summed in it, and a set's order changes with the hash seed.
+        names = [n for n in SEQUENCE_NAMES if n in self.choice.weights or n in self._previous_weights]
         return {n: self._previous_weights.get(n, 0.0) + ease * (self.choice.weights.get(n, 0.0) - self._previous_weights.get(n, 0.0))
                 for n in names}
 

@@ -26,6 +26,9 @@ class ThinPlateFluid:
         self._mass_fraction = body.mass_kg / body.mass_kg.sum()
         self._half = np.ascontiguousarray(body.half_extents_m)
         self._flow = np.zeros((len(body.segment_names), 3))
+        # The buoyancy part of the last ``wrenches`` force, for logs that separate it from the
+        # hydrodynamic force (the part a stroke can change).
+        self.buoyancy_force_n = np.zeros((len(body.segment_names), 3))
 
     def flow_at_swimmer(self, pos_m, quat_xyzw, linvel_m_s) -> np.ndarray:
         m = self.medium
@@ -48,4 +51,5 @@ class ThinPlateFluid:
                                        m.rho_kg_m3, m.eta_pa_s, m.surface_z_m, self.table, m.patches_per_edge)
         b_force, b_torque = buoyancy_wrenches(pos_m, quat_xyzw, self.body.semi_axes_m, self.body.volume_m3,
                                               m.rho_kg_m3, m.gravity_m_s2, m.surface_z_m, m.exact_buoyancy)
+        self.buoyancy_force_n = b_force
         return force + b_force, torque + b_torque

@@ -82,6 +82,9 @@ class Simulation:
         self.steps = 0
         self.state: BodyState | None = None
         self.fluid_force_n = np.zeros((len(body.segment_names), 3))
+        # Pushes from outside the water (experiments' impulses), per segment at its centre of
+        # mass, world frame; applied every step until changed.
+        self.external_force_n = np.zeros((len(body.segment_names), 3))
         self.desired_pose = self.desired_rate = None
 
     @property
@@ -103,6 +106,7 @@ class Simulation:
         pose, _ = self.controller.desired(0.0, None)  # the stroke's pose at phase 0 needs no state
         self.world.reset((*position_xy_m, -depth_m), quat, pose, velocity)
         self.steps = 0
+        self.external_force_n[:] = 0.0
         self.state = self.world.read_state()
 
     def step(self) -> BodyState:
@@ -112,7 +116,7 @@ class Simulation:
             self.world.set_targets(self.desired_pose, self.desired_rate)
         force, torque = self.fluid.wrenches(state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s)
         self.fluid_force_n = force
-        self.world.apply_wrenches(force, torque, state.pos_m)
+        self.world.apply_wrenches(force + self.external_force_n, torque, state.pos_m)
         self.world.drive()
         self.world.step()
         self.steps += 1

@@ -134,10 +134,35 @@ class World:
         states = self.client.getJointStatesMultiDof(self.uid, self.motor_indices)
         return np.concatenate([s[0] for s in states])
 
-    def joint_motor_torques(self) -> np.ndarray:
-        """Torques the stable PD applied on the last step, flattened motor by motor."""
+    def enable_joint_torque_sensors(self) -> None:
+        """Have every step compute the wrench each motor joint transmits (``joint_torques_and_rates``).
+        Off by default: it costs a few per cent of the step."""
+        c = self.client
+        for joint in self.motor_indices:
+            c.enableJointForceTorqueSensor(self.uid, joint, True)
+        # The transmitted wrench comes about the child's centre of mass; the joint pivot is the
+        # child link's origin. A hinge's torque is the wrench's part along its axis.
+        com_m = np.array([c.getDynamicsInfo(self.uid, j)[3] for j in self.motor_indices])
+        rows = []
+        for m, (joint, is_ball) in enumerate(zip(self.motor_indices, self.layout.motor_is_ball)):
+            axes = np.eye(3) if is_ball else np.array([c.getJointInfo(self.uid, joint)[13]])
+            for axis in axes:
+                row = np.zeros((len(self.motor_indices), 3))
+                row[m] = axis
+                rows.append(row.ravel())
+        self._torque_com_m, self._torque_rows = com_m, np.array(rows)
+
+    def joint_torques_and_rates(self) -> tuple[np.ndarray, np.ndarray]:
+        """Torque each motor applied during the last step (N m) and the joint rates now (rad/s),
+        flattened motor by motor as in ``joint_positions``: a ball joint's three components in the
+        child frame, one value per hinge; their dot product is the joints' mechanical power.
+        PyBullet reports no applied torque under STABLE_PD_CONTROL, so the torque is read from the
+        joint's transmitted wrench (``enable_joint_torque_sensors`` first): a ball joint passes no
+        torque but the motor's, and a hinge none about its axis but the motor's."""
         states = self.client.getJointStatesMultiDof(self.uid, self.motor_indices)
-        return np.concatenate([s[3] for s in states])
+        wrench = np.array([s[2] for s in states])
+        about_pivot = wrench[:, 3:] + np.cross(self._torque_com_m, wrench[:, :3])
+        return self._torque_rows @ about_pivot.ravel(), np.concatenate([s[1] for s in states])
 
     # --- actions -----------------------------------------------------------------------
     def apply_wrenches(self, force_n: np.ndarray, torque_nm: np.ndarray, at_m: np.ndarray) -> None:

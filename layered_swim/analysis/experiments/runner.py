@@ -1,0 +1,44 @@
+"""Runs one experiment: its configurations through the cached parallel sweep, then its figure,
+CSV and report. An experiment module provides
+
+- ``NAME``, ``TITLE``, ``PAPER`` (the paper's finding, in words), ``FIGURE`` and ``CSV`` file names;
+- ``configs(quick, seed)``: the runs, as JSON-able dicts (they are also the cache keys);
+- ``run(config)``: one simulation, returning a JSON-able result (module level, so it pickles);
+- ``finish(configs, results, out_dir)``: draws the figure, writes the CSV, returns an ``Outcome``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from layered_swim.analysis import report
+from layered_swim.analysis.sweep import run_sweep
+from layered_swim.config import ConfigError
+from layered_swim.runs import _write_json, versions
+
+
+@dataclass(frozen=True)
+class Outcome:
+    ours: str                    # our finding, with our numbers
+    setting: str                 # what was simulated
+    differs: str | None = None   # where and why ours differs from the paper
+    numbers: dict = field(default_factory=dict)
+
+
+def run_experiment(module, out_dir: str | Path, quick: bool = False, workers: int = 2, progress: bool = False,
+                   seed: int = 0) -> dict:
+    if not isinstance(seed, int) or seed < 0:
+        raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    configs = module.configs(quick, seed)
+    results = run_sweep(module.run, configs, out / "cache", workers, progress, desc=module.NAME)
+    outcome = module.finish(configs, results, out)
+    _write_json(out / "config.json", {"experiment": module.NAME, "quick": quick, "seed": seed, "runs": configs,
+                                      "versions": versions()})
+    summary = {"experiment": module.NAME, "title": module.TITLE, "paper": module.PAPER, "ours": outcome.ours,
+               "differs": outcome.differs, "setting": outcome.setting, **outcome.numbers}
+    _write_json(out / "summary.json", summary)
+    (out / "report.md").write_text(report.experiment_report(module.TITLE, module.FIGURE, module.CSV, module.PAPER,
+                                                            outcome.ours, outcome.setting, outcome.differs))
+    return {**summary, "files": [module.FIGURE, module.CSV, "summary.json", "config.json", "report.md"]}

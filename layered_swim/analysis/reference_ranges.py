@@ -1,0 +1,67 @@
+"""Real swimmers' ranges from the data sheet (reference/data-sheet.md, section 3), per stroke,
+and the verdict of a measured number against them (inside / below / above).
+
+Only the data sheet's numbers are used; a quantity it gives no range for gets none here, and
+the report says so rather than inventing one.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+DATA_SHEET = "data sheet section 3"
+
+
+@dataclass(frozen=True)
+class Range:
+    low: float
+    high: float
+    source: str
+
+    def verdict(self, value: float | None) -> str:
+        if value is None:
+            return "n/a"
+        return "below" if value < self.low else "above" if value > self.high else "inside"
+
+
+PEAK_HAND_FORCE = Range(70.0, 150.0, "peak hand force, typical studies (R)")
+
+RANGES: dict[str, dict[str, Range]] = {
+    "front_crawl": {
+        "mean_speed_m_s": Range(0.8, 1.2, "recreational crawl speed (R)"),
+        "stroke_rate_cpm": Range(50.0, 55.0, "elite freestyle stroke rate (Hay 1984)"),
+        "distance_per_cycle_m": Range(2.2, 2.5, "elite freestyle distance per cycle (Hay 1984)"),
+        "speed_fluctuation_pct": Range(15.0, 20.0, "crawl intracycle speed fluctuation +-15-20 % (Craig & Pendergast 1979)"),
+        "shoulder_roll_deg": Range(45.0, 60.0, "front-crawl shoulder roll per side (Psycharakis & Sanders 2010)"),
+        "hip_roll_deg": Range(30.0, 45.0, "front-crawl hip roll per side (Psycharakis & Sanders 2010)"),
+        "peak_hand_force_n": PEAK_HAND_FORCE,
+    },
+    "breaststroke": {
+        "mean_speed_m_s": Range(0.6, 1.0, "recreational breaststroke speed (R)"),
+        "stroke_rate_cpm": Range(50.0, 60.0, "elite breaststroke stroke rate (Hay 1984)"),
+        "distance_per_cycle_m": Range(1.8, 2.0, "elite breaststroke distance per cycle (Hay 1984)"),
+        "speed_fluctuation_pct": Range(45.0, 50.0, "breaststroke intracycle speed fluctuation +-45-50 % (Craig & Pendergast 1979)"),
+        "peak_hand_force_n": PEAK_HAND_FORCE,
+    },
+    "treading_water": {
+        # The sheet says "~1 Hz leg cycles"; +-10 % around it is our reading of "~".
+        "stroke_rate_cpm": Range(54.0, 66.0, "eggbeater leg cycles ~1 Hz (E/R), +-10 %"),
+    },
+}
+
+# Narita et al. 2017 (D = 32.2 v^3.3 N) and Cortesi et al. 2024 (~38 v^2 N) measured active drag
+# on real swimmers; at a given speed the two bound the range we compare with.
+ACTIVE_DRAG_LAWS = ((32.2, 3.3, "Narita et al. 2017"), (38.0, 2.0, "Cortesi et al. 2024"))
+
+
+def active_drag_range(speed_m_s: float) -> Range:
+    values = [k * abs(speed_m_s) ** p for k, p, _ in ACTIVE_DRAG_LAWS]
+    names = " and ".join(f"{k:g} v^{p:g} N ({who})" for k, p, who in ACTIVE_DRAG_LAWS)
+    return Range(min(values), max(values), f"active drag at this speed, between {names}")
+
+
+def ranges_for(stroke: str, speed_m_s: float | None) -> dict[str, Range]:
+    """Every range that applies to ``stroke`` (none for strokes the sheet does not cover)."""
+    out = dict(RANGES.get(stroke, {}))
+    if speed_m_s is not None and stroke in ("front_crawl", "breaststroke"):
+        out["active_drag_n"] = active_drag_range(speed_m_s)
+    return out

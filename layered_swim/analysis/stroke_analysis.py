@@ -1,0 +1,114 @@
+"""``layered-swim analyze``: a steady swim, measured cycle by cycle.
+
+``analyze_stroke`` simulates one configuration and returns everything the report needs as plain
+JSON-able data (so ``compare`` can cache it and draw again without simulating);
+``write_analysis`` turns that into summary.json, cycles.csv, profiles.csv, config.json, the
+plots and report.md.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from layered_swim.analysis import plots, report
+from layered_swim.analysis.drag import towed_drag
+from layered_swim.analysis.files import write_csv
+from layered_swim.analysis.reference_ranges import ranges_for
+from layered_swim.analysis.stroke_metrics import SwimmerInfo, analyze_log
+from layered_swim.analysis.sweep import file_sha256, run_sweep
+from layered_swim.config import ConfigError
+from layered_swim.control.stroke import stroke_path
+from layered_swim.runs import _check_seconds, _run, _write_json, build_swim, make_medium, resolved_config
+from layered_swim.sim.recorder import Recorder
+
+ANALYSIS_LOG_HZ = 120      # ~100 samples per stroke cycle for the profiles
+DEFAULT_SETTLE_S = 5.0
+PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_figure,
+         "propulsion_power.png": plots.propulsion_figure, "attitude.png": plots.attitude_figure}
+
+
+def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | None = None,
+                    current_m_s=(0.0, 0.0, 0.0), fluid: str = "fresh_water", settle_s: float = DEFAULT_SETTLE_S,
+                    seed: int = 0, physics_hz: int = 480) -> dict:
+    """The resolved, JSON-able configuration of one analysis (also its cache key)."""
+    _check_seconds(seconds)
+    if not (math.isfinite(settle_s) and 0.0 <= settle_s < seconds):
+        raise ConfigError(f"settle time must be at least 0 and shorter than the swim ({seconds:g} s), got {settle_s}")
+    return {"stroke": stroke, "stroke_file_sha256": file_sha256(stroke_path(stroke)), "seconds": float(seconds),
+            "density_kg_m3": density_kg_m3, "current_m_s": [float(c) for c in current_m_s], "fluid": fluid,
+            "settle_s": float(settle_s), "seed": seed, "physics_hz": physics_hz}
+
+
+def analyze_stroke(config: dict, progress: bool = False) -> dict:
+    medium = make_medium(config["fluid"], config["density_kg_m3"]).with_(current_m_s=tuple(config["current_m_s"]))
+    setup = build_swim(config["stroke"], medium=medium, physics_hz=config["physics_hz"], seed=config["seed"])
+    sim = setup.sim
+    try:
+        recorder = Recorder(sim, ANALYSIS_LOG_HZ, joint_work=True)
+        _run(sim, config["seconds"], recorder, progress)
+    finally:
+        sim.close()
+    posture = setup.stroke.start.posture
+    result = analyze_log(recorder.arrays(), SwimmerInfo(sim.body.segment_names, posture, setup.stroke.period_s,
+                                                        config["settle_s"]))
+    summary = result["summary"]
+    speed = summary["mean_speed_m_s"]["mean"]
+    # The same body towed in a streamlined glide at the swimming speed: what the stroke adds.
+    summary["passive_drag_n"] = towed_drag(sim.body, sim.medium, (abs(speed),))[0]["drag_n"] if posture == "prone" else None
+    summary["nominal_stroke_rate_cpm"] = 60.0 / setup.stroke.period_s
+    return {"stroke": setup.stroke.name, "posture": posture, **result,
+            "config": resolved_config(setup, config, ANALYSIS_LOG_HZ)}
+
+
+def comparisons(result: dict) -> list[dict]:
+    """Every summary number next to the real swimmers' range for this stroke, where there is one."""
+    summary = result["summary"]
+    ranges = ranges_for(result["stroke"], summary["mean_speed_m_s"]["mean"])
+    rows = []
+    for name in report.SUMMARY_ROWS:
+        value = summary.get(name)
+        if value is None:
+            continue
+        mean = value["mean"] if isinstance(value, dict) else value
+        sd = value["sd"] if isinstance(value, dict) else None
+        rng = ranges.get(name)
+        rows.append({"quantity": name, "mean": mean, "sd": sd,
+                     "low": rng.low if rng else None, "high": rng.high if rng else None,
+                     "verdict": rng.verdict(mean) if rng else "no range in the data sheet",
+                     "source": rng.source if rng else ""})
+    return rows
+
+
+def write_analysis(result: dict, out_dir: str | Path) -> list[str]:
+    """Write every output file of one analysis into ``out_dir``; returns their names."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    table = comparisons(result)
+    _write_json(out / "summary.json", {"stroke": result["stroke"], "posture": result["posture"],
+                                       **result["summary"], "comparison": table})
+    _write_json(out / "config.json", result["config"])
+    write_csv(out / "cycles.csv", result["cycles"])
+    profiles = result["profiles"]
+    points = len(next(iter(profiles.values()))["mean"])
+    write_csv(out / "profiles.csv", [
+        {"cycle_pct": 100.0 * i / (points - 1),
+         **{f"{name}_{stat}": profiles[name][stat][i] for name in profiles for stat in ("mean", "sd")}}
+        for i in range(points)])
+    for name, draw in PLOTS.items():
+        draw(result, out / name)
+    (out / "report.md").write_text(report.analysis_report(result, table, list(PLOTS)))
+    return ["summary.json", "config.json", "cycles.csv", "profiles.csv", *PLOTS, "report.md"]
+
+
+def write_comparison(configs: list[dict], out_dir: str | Path, workers: int = 2, progress: bool = False) -> list[dict]:
+    """Analyze every configuration (in parallel, cached under ``out_dir/cache``), write each
+    stroke's full outputs into ``out_dir/<stroke>/`` and the side-by-side report."""
+    out = Path(out_dir)
+    results = run_sweep(analyze_stroke, configs, out / "cache", workers, progress, desc="strokes")
+    tables = []
+    for result in results:
+        write_analysis(result, out / result["stroke"])
+        tables.append(comparisons(result))
+    plots.compare_figure(results, out / "compare_profiles.png")
+    (out / "report.md").write_text(report.compare_report(results, tables, "compare_profiles.png"))
+    return results
