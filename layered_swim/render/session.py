@@ -202,12 +202,12 @@ class SwimSession:
         """Exactly ``steps`` physics steps (single-stepping, headless rendering)."""
         if self.diverged:
             return
+        blend = 1.0 - math.exp(-1.0 / (self.physics_hz * SPEED_TIME_CONSTANT_S))   # per-step speed smoothing
         try:
             for _ in range(steps):
                 state = self.sim.step()
                 if self.sim.time_s >= self._next_trail_s:
                     self._record_trail()
-                blend = 1.0 - math.exp(-1.0 / (self.physics_hz * SPEED_TIME_CONSTANT_S))
                 velocity = self._mass_fraction @ state.linvel_m_s
                 self.speed_m_s += blend * (math.hypot(velocity[0], velocity[1]) - self.speed_m_s)
         except SimulationDiverged as err:

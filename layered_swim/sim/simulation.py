@@ -83,8 +83,8 @@ class Simulation:
         self.state: BodyState | None = None
         self.fluid_force_n = np.zeros((len(body.segment_names), 3))
         # Pushes from outside the water (experiments' impulses), per segment at its centre of
-        # mass, world frame; applied every step until changed.
-        self.external_force_n = np.zeros((len(body.segment_names), 3))
+        # mass, world frame; None until the first ``push``, so a plain swim does no extra work.
+        self.external_force_n: np.ndarray | None = None
         self.desired_pose = self.desired_rate = None
 
     @property
@@ -106,8 +106,15 @@ class Simulation:
         pose, _ = self.controller.desired(0.0, None)  # the stroke's pose at phase 0 needs no state
         self.world.reset((*position_xy_m, -depth_m), quat, pose, velocity)
         self.steps = 0
-        self.external_force_n[:] = 0.0
+        self.external_force_n = None
         self.state = self.world.read_state()
+
+    def push(self, force_n, segment: int = 0) -> None:
+        """Push ``segment`` (default the pelvis) with ``force_n`` (world frame, at its centre of
+        mass) on every step from now until changed; zero stops it."""
+        if self.external_force_n is None:
+            self.external_force_n = np.zeros((len(self.body.segment_names), 3))
+        self.external_force_n[segment] = force_n
 
     def step(self) -> BodyState:
         state = self.state if self.state is not None else self.world.read_state()
@@ -116,7 +123,9 @@ class Simulation:
             self.world.set_targets(self.desired_pose, self.desired_rate)
         force, torque = self.fluid.wrenches(state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s)
         self.fluid_force_n = force
-        self.world.apply_wrenches(force + self.external_force_n, torque, state.pos_m)
+        if self.external_force_n is not None:
+            force = force + self.external_force_n
+        self.world.apply_wrenches(force, torque, state.pos_m)
         self.world.drive()
         self.world.step()
         self.steps += 1

@@ -53,7 +53,7 @@ def push(config: dict, weight_n: float):
     if config["kind"] == "impulse":
         force = config["mg"] * weight_n * np.array(DIRECTIONS[config["direction"]])
         start, end = config["at_s"], config["at_s"] + config["for_s"]
-        return lambda sim: sim.external_force_n.__setitem__(0, force if start <= sim.time_s < end else 0.0)
+        return lambda sim: sim.push(force if start <= sim.time_s < end else 0.0)
     if config["kind"] == "random":
         rng = np.random.default_rng(config["seed"])
         n = int(np.ceil((config["seconds"] - config["from_s"]) / config["hold_s"])) + 1
@@ -62,7 +62,7 @@ def push(config: dict, weight_n: float):
 
         def on_step(sim) -> None:
             k = int((sim.time_s - config["from_s"]) // config["hold_s"])
-            sim.external_force_n[0] = forces[k] if k >= 0 else 0.0
+            sim.push(forces[k] if k >= 0 else 0.0)
         return on_step
     return None
 
