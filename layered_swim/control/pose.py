@@ -73,46 +73,55 @@ class JointLayout:
     def ball_targets(self, pose: np.ndarray, rates: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Ball joints' child-in-parent quaternions (n_ball, 4) and child-frame angular
         velocities (n_ball, 3) for a pose and its rates."""
-        return _ball_targets(pose[self.ball_coords], rates[self.ball_coords], self.ball_axes)
+        return _ball_targets(pose, rates, self.ball_coords, self.ball_axes)
 
     def ball_quaternions(self, pose: np.ndarray) -> np.ndarray:
         return self.ball_targets(pose, np.zeros_like(pose))[0]
 
 
-@njit(cache=True)
-def _quat_mul(a, b):
-    return np.array([
-        a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
-        a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
-        a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
-        a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2],
-    ])
+@njit(cache=True, inline="always")
+def _quat_mul(a, b, out):
+    out[0] = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1]
+    out[1] = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0]
+    out[2] = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3]
+    out[3] = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2]
+
+
+@njit(cache=True, inline="always")
+def _add_rotated_inverse(q, v0, v1, v2, out):
+    """out += v rotated by the conjugate of unit quaternion q (no temporaries: this runs per joint
+    per control step)."""
+    ux, uy, uz, w = -q[0], -q[1], -q[2], q[3]
+    tx = 2.0 * (uy * v2 - uz * v1)
+    ty = 2.0 * (uz * v0 - ux * v2)
+    tz = 2.0 * (ux * v1 - uy * v0)
+    out[0] += v0 + w * tx + uy * tz - uz * ty
+    out[1] += v1 + w * ty + uz * tx - ux * tz
+    out[2] += v2 + w * tz + ux * ty - uy * tx
 
 
 @njit(cache=True)
-def _rotate_inverse(q, v):
-    """Rotate v by the conjugate of unit quaternion q."""
-    u = -q[:3]
-    t = 2.0 * np.cross(u, v)
-    return v + q[3] * t + np.cross(u, t)
-
-
-@njit(cache=True)
-def _ball_targets(angles, rates, axes):
-    n = angles.shape[0]
+def _ball_targets(pose, rates, coords, axes):
+    n = coords.shape[0]
     quats = np.empty((n, 4))
-    omegas = np.empty((n, 3))
+    omegas = np.zeros((n, 3))
+    parts = np.empty((3, 4))
+    r23 = np.empty(4)
     for j in range(n):
-        parts = np.empty((3, 4))
         for k in range(3):
-            h = 0.5 * angles[j, k]
-            parts[k, :3] = axes[j, k] * np.sin(h)
+            h = 0.5 * pose[coords[j, k]]
+            sin_h = np.sin(h)
+            for i in range(3):
+                parts[k, i] = axes[j, k, i] * sin_h
             parts[k, 3] = np.cos(h)
-        r23 = _quat_mul(parts[1], parts[2])
-        quats[j] = _quat_mul(parts[0], r23)
+        _quat_mul(parts[1], parts[2], r23)
+        _quat_mul(parts[0], r23, quats[j])
         # Intrinsic chain R1 R2 R3: in the child frame axis k is seen through the later rotations.
-        omegas[j] = (axes[j, 2] * rates[j, 2] + _rotate_inverse(parts[2], axes[j, 1] * rates[j, 1])
-                     + _rotate_inverse(r23, axes[j, 0] * rates[j, 0]))
+        r0, r1, r2 = rates[coords[j, 0]], rates[coords[j, 1]], rates[coords[j, 2]]
+        for i in range(3):
+            omegas[j, i] = axes[j, 2, i] * r2
+        _add_rotated_inverse(parts[2], axes[j, 1, 0] * r1, axes[j, 1, 1] * r1, axes[j, 1, 2] * r1, omegas[j])
+        _add_rotated_inverse(r23, axes[j, 0, 0] * r0, axes[j, 0, 1] * r0, axes[j, 0, 2] * r0, omegas[j])
     return quats, omegas
 
 

@@ -107,6 +107,11 @@ class World:
             kd.append(joint.kd * s)
             force.append([joint.max_torque_nm] * (3 if is_ball else 1))
         self._kp, self._kd, self._force = kp, kd, force
+        n_ball = len(layout.ball_slices)
+        self._position_cuts = [(4 * b, 4 * b + 4) if b >= 0 else (4 * n_ball + k, 4 * n_ball + k + 1)
+                               for b, k in zip(layout.motor_ball, layout.motor_coord)]
+        self._velocity_cuts = [(3 * b, 3 * b + 3) if b >= 0 else (3 * n_ball + k, 3 * n_ball + k + 1)
+                               for b, k in zip(layout.motor_ball, layout.motor_coord)]
 
     # --- state -------------------------------------------------------------------------
     def reset(self, root_pos_m, root_quat_xyzw, pose: np.ndarray, root_linvel_m_s=(0.0, 0.0, 0.0)) -> None:
@@ -129,7 +134,8 @@ class World:
         uid, cid = self.uid, self._cid
         base_pos, base_quat = pybullet.getBasePositionAndOrientation(uid, cid)
         base_lin, base_ang = pybullet.getBaseVelocity(uid, cid)
-        links = pybullet.getLinkStates(uid, self._child_links, 1, 1, cid)   # with velocities, fresh kinematics
+        # With velocities, and the kinematics recomputed: the cached link frames are stale after a step.
+        links = pybullet.getLinkStates(uid, self._child_links, 1, 1, cid)
         # One flat pass into one array: per segment position, quaternion, velocity, spin.
         flat = chain(base_pos, base_quat, base_lin, base_ang, _flatten(_flatten(map(_COM_STATE, links))))
         table = np.fromiter(flat, np.float64, self._state_size).reshape(-1, 13)
@@ -183,12 +189,12 @@ class World:
 
     def set_targets(self, pose: np.ndarray, rates: np.ndarray) -> None:
         """Convert a desired pose and its rates into PyBullet's per-motor targets (at control rate)."""
-        layout = self.layout
-        quats, omegas = layout.ball_targets(pose, rates)
-        quats, omegas = quats.tolist(), omegas.tolist()
-        pose_list, rate_list = pose.tolist(), rates.tolist()
-        self._targets = [quats[b] if b >= 0 else [pose_list[k]] for b, k in zip(layout.motor_ball, layout.motor_coord)]
-        self._velocities = [omegas[b] if b >= 0 else [rate_list[k]] for b, k in zip(layout.motor_ball, layout.motor_coord)]
+        quats, omegas = self.layout.ball_targets(pose, rates)
+        # One list per kind, cut motor by motor (ball joints first in it, then every pose angle).
+        positions = quats.ravel().tolist() + pose.tolist()
+        velocities = omegas.ravel().tolist() + rates.tolist()
+        self._targets = [positions[a:b] for a, b in self._position_cuts]
+        self._velocities = [velocities[a:b] for a, b in self._velocity_cuts]
 
     def drive(self) -> None:
         """Stable PD toward the last targets. PyBullet computes the torque once per call and holds
