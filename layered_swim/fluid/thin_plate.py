@@ -34,8 +34,8 @@ def _flow_at_swimmer(quat, linvel, mass_fraction, current, r_min, r_max, axial):
 @njit(cache=True)
 def _fluid_wrenches(pos, quat, linvel, angvel, segments, medium, coefficients):
     """``segments`` (n, 8): half extents, ellipsoid semi-axes, mass fraction, volume; ``medium``:
-    see ThinPlateFluid._pack_medium; ``coefficients`` (3, k): angles, C_L, C_D. Packed so that the
-    per-step call passes seven arguments, not twenty."""
+    the current, then the scalars in the order ThinPlateFluid.__init__ packs them; ``coefficients``
+    (3, k): angles, C_L, C_D. Packed so that the per-step call passes seven arguments, not twenty."""
     half, semi, mass_fraction, volume = segments[:, 0:3], segments[:, 3:6], segments[:, 6], segments[:, 7]
     current = medium[0:3]
     r_min, r_max, axial, rho, eta, surface_z, g, exact, patches = medium[3:12]
@@ -57,8 +57,9 @@ class ThinPlateFluid:
         self._segments = np.ascontiguousarray(np.column_stack(
             [body.half_extents_m, body.semi_axes_m, self._mass_fraction, body.volume_m3]), dtype=np.float64)
         m = medium
-        self._medium = np.array([*m.current_m_s, m.r_min, m.r_max, m.axial_induced_flow, m.rho_kg_m3, m.eta_pa_s,
-                                 m.surface_z_m, abs(m.gravity_m_s2), m.exact_buoyancy, m.patches_per_edge], dtype=np.float64)
+        self._medium = np.array([*m.current_m_s, m.r_min, m.r_max, m.axial_induced_flow, m.rho_kg_m3,
+                                 m.eta_pa_s, m.surface_z_m, abs(m.gravity_m_s2), m.exact_buoyancy,
+                                 m.patches_per_edge], dtype=np.float64)
         self._coefficients = np.ascontiguousarray(np.vstack(self.table), dtype=np.float64)
         # The buoyancy part of the last ``wrenches`` force, for logs that separate it from the
         # hydrodynamic force (the part a stroke can change).
