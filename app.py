@@ -15,12 +15,12 @@ PROG = "app.py"
 
 
 def parser() -> argparse.ArgumentParser:
+    from layered_swim.cli import steering_options   # argparse only: --help stays fast
+
     p = argparse.ArgumentParser(prog=PROG, description="Swim after the mouse (or a trajectory) in a real-time 3-D window.")
     p.add_argument("--stroke", default="breaststroke", help="stroke name or path to a stroke .yaml (default breaststroke)")
     p.add_argument("--trajectory", help="a trajectory name or .yaml file: show its path and chase its target")
-    p.add_argument("--layers", default="basic,cycle,rules", help="basic[,cycle][,rules|palm|reach] (keys toggle them)")
-    p.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
-    p.add_argument("--density", type=float, metavar="KG_M3", help="fluid density (default fresh water)")
+    steering_options(p)   # --layers (keys toggle them), --current, --density
     p.add_argument("--size", default="1280x720", metavar="WxH", help="window size in pixels")
     p.add_argument("--capture-dir", default="captures", help="where screenshots and videos go (default captures/)")
     p.add_argument("--benchmark-frames", type=int, metavar="N",
@@ -30,36 +30,32 @@ def parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
-    from layered_swim.cli import _guard_stdout, _one_line, _size, _vector   # noqa: I001 (after parsing: a fast --help)
+    from layered_swim.cli import _guard_stdout, report_errors
     _guard_stdout()
+    return report_errors(PROG, lambda: _open_window(args))
+
+
+def _open_window(args) -> None:
+    from layered_swim.cli import _size, _vector
     from layered_swim.config import ConfigError
-    from layered_swim.sim.simulation import SimulationDiverged
+    from layered_swim.control.layered import Layers
+    from layered_swim.render.session import SwimSession
 
-    try:
-        from layered_swim.render.session import SwimSession
-        from layered_swim.control.layered import Layers
+    width, height = _size(args.size)
+    if args.benchmark_frames is not None and args.benchmark_frames < 2:
+        raise ConfigError(f"--benchmark-frames must be at least 2, got {args.benchmark_frames}")
+    session = SwimSession(args.stroke, Layers.parse(args.layers), _vector(args.current, "--current"), args.density,
+                          args.trajectory)
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        session.close()
+        raise ConfigError("no display to open a window on (run it on a desktop, or under xvfb-run); "
+                          "`layered-swim render` draws videos without one")
+    from layered_swim.render.window import SwimWindow
 
-        width, height = _size(args.size)
-        if args.benchmark_frames is not None and args.benchmark_frames < 2:
-            raise ConfigError(f"--benchmark-frames must be at least 2, got {args.benchmark_frames}")
-        session = SwimSession(args.stroke, Layers.parse(args.layers), _vector(args.current, "--current"), args.density,
-                              args.trajectory)
-        if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-            session.close()
-            raise ConfigError("no display to open a window on (run it on a desktop, or under xvfb-run); "
-                              "`layered-swim render` draws videos without one")
-        from layered_swim.render.window import SwimWindow
-
-        window = SwimWindow(session, width, height, Path(args.capture_dir), args.benchmark_frames)
-        window.run()
-        if window.benchmark is not None:
-            print(json.dumps(window.benchmark))
-    except (ConfigError, SimulationDiverged, OSError) as err:
-        print(f"{PROG}: error: {_one_line(err)}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        return 130
-    return 0
+    window = SwimWindow(session, width, height, Path(args.capture_dir), args.benchmark_frames)
+    window.run()
+    if window.benchmark is not None:
+        print(json.dumps(window.benchmark))
 
 
 if __name__ == "__main__":

@@ -10,7 +10,6 @@ import json
 import math
 import os
 import sys
-import time
 from pathlib import Path
 
 PROG = "layered-swim"
@@ -39,11 +38,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     run.add_argument("--lung-volume", type=float, dest="lung_air_l", metavar="L",
                      help="inhaled air in litres, on top of the residual volume (default 3)")
-    fluid = run.add_mutually_exclusive_group()
-    fluid.add_argument("--density", type=float, metavar="KG_M3", help="water density (fresh water's viscosity)")
-    fluid.add_argument("--fluid", choices=("fresh_water", "seawater"), default="fresh_water")
-    run.add_argument("--seed", type=int, default=0)
-    run.add_argument("--physics-hz", type=int, default=480)
+    _water_options(run)
     run.add_argument("--tempo", type=float, default=1.0, help="stroke rate multiplier (default 1)")
 
     sub.add_parser("strokes", help="list the available strokes")
@@ -59,9 +54,7 @@ def _parser() -> argparse.ArgumentParser:
     follow = sub.add_parser("follow", help="chase a target moving along a trajectory file")
     follow.add_argument("trajectory", help="trajectory name (see trajectories/) or path to a .yaml")
     follow.add_argument("--stroke", default="breaststroke")
-    follow.add_argument("--layers", default="basic,cycle,rules", help="basic[,cycle][,rules|palm|reach]")
-    follow.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
-    follow.add_argument("--density", type=float, metavar="KG_M3")
+    steering_options(follow)
     follow.add_argument("--seconds", type=float, default=60.0)
     follow.add_argument("--out", help="output folder (default runs/follow-<trajectory>-<timestamp>)")
     follow.add_argument("--json", action="store_true")
@@ -69,8 +62,7 @@ def _parser() -> argparse.ArgumentParser:
     goal = sub.add_parser("goal", help="SWIM's goal-reaching benchmark (Pos, Prog, Dev, Roll)")
     goal.add_argument("--pool", choices=("small", "large"), default="small")
     goal.add_argument("--stroke", default="front_crawl")
-    goal.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
-    goal.add_argument("--layers", default="basic,cycle,rules")
+    steering_options(goal, density=False)
     goal.add_argument("--json", action="store_true")
 
     render = sub.add_parser("render", help="draw a run folder or a trajectory swim to a video or PNG frames, no display needed")
@@ -80,9 +72,7 @@ def _parser() -> argparse.ArgumentParser:
     render.add_argument("--fps", type=float, default=30.0)
     render.add_argument("--size", default="960x540", metavar="WxH")
     render.add_argument("--stroke", default="breaststroke", help="stroke for a trajectory (default breaststroke)")
-    render.add_argument("--layers", default="basic,cycle,rules")
-    render.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
-    render.add_argument("--density", type=float, metavar="KG_M3")
+    steering_options(render)
     render.add_argument("--forces", action="store_true", help="draw the per-segment fluid-force arrows")
     render.add_argument("--no-progress", action="store_true", help="no progress bar")
 
@@ -93,12 +83,8 @@ def _parser() -> argparse.ArgumentParser:
     for command in (analyze, compare):
         command.add_argument("--seconds", type=float, default=60.0, help="simulated seconds (default 60)")
         command.add_argument("--settle", type=float, default=5.0, metavar="S", help="seconds left out at the start (default 5)")
-        medium = command.add_mutually_exclusive_group()
-        medium.add_argument("--density", type=float, metavar="KG_M3", help="water density (fresh water's viscosity)")
-        medium.add_argument("--fluid", choices=("fresh_water", "seawater"), default="fresh_water")
-        command.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
-        command.add_argument("--seed", type=int, default=0)
-        command.add_argument("--physics-hz", type=int, default=480)
+        _water_options(command)
+        _current_option(command)
         command.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     analyze.add_argument("--out", help="output folder (default runs/analyze-<stroke>-<timestamp>)")
     compare.add_argument("--out", help="output folder (default runs/compare-<timestamp>)")
@@ -117,6 +103,32 @@ def _parser() -> argparse.ArgumentParser:
     bench.add_argument("--seconds", type=float, default=5.0, help="simulated seconds per repeat (default 5)")
     bench.add_argument("--physics-hz", type=int, default=480)
     return p
+
+
+def _water_options(command: argparse.ArgumentParser) -> None:
+    """Density or fluid preset, seed and physics rate: the options of a single swim."""
+    fluid = command.add_mutually_exclusive_group()
+    fluid.add_argument("--density", type=float, metavar="KG_M3", help="water density (fresh water's viscosity)")
+    fluid.add_argument("--fluid", choices=("fresh_water", "seawater"), default="fresh_water")
+    command.add_argument("--seed", type=int, default=0)
+    command.add_argument("--physics-hz", type=int, default=480)
+
+
+def _current_option(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
+
+
+def steering_options(command: argparse.ArgumentParser, density: bool = True) -> None:
+    """The options of a swim toward a target: layers, current and (optionally) density; app.py has them too."""
+    command.add_argument("--layers", default="basic,cycle,rules", help="basic[,cycle][,rules|palm|reach]")
+    _current_option(command)
+    if density:
+        command.add_argument("--density", type=float, metavar="KG_M3", help="water density (default fresh water)")
+
+
+def _progress(args) -> bool:
+    """A progress bar only where someone watches stderr."""
+    return not args.no_progress and sys.stderr.isatty()
 
 
 def _parallel_options(command: argparse.ArgumentParser) -> None:
@@ -221,7 +233,7 @@ def _cmd_calibrate(args) -> None:
     from layered_swim.control.stroke import load_stroke
 
     stroke = load_stroke(args.stroke, joint_layout(load_body()))
-    table = calibrate(stroke, workers=max(1, args.workers), progress=not args.no_progress and sys.stderr.isatty())
+    table = calibrate(stroke, workers=max(1, args.workers), progress=_progress(args))
     path = save_table(table, calibration_path(stroke.name))
     rows = [[name, f"{table.tempos[-1]:g}"] + [f"{math.degrees(v):.1f}" for v in turns[-1]]
             for name, turns in table.turn_rad.items()]
@@ -233,7 +245,9 @@ def _cmd_follow(args) -> None:
     from layered_swim.control.layered import Layers
     from layered_swim.tasks import follow_run
 
-    out = args.out or str(Path("runs") / f"follow-{Path(args.trajectory).stem}-{time.strftime('%Y%m%d-%H%M%S')}")
+    from layered_swim.runs import default_out_dir
+
+    out = args.out or str(default_out_dir(f"follow-{Path(args.trajectory).stem}"))
     result = follow_run(args.trajectory, args.stroke, Layers.parse(args.layers), _vector(args.current, "--current"),
                         args.density, args.seconds, out)
     if args.json:
@@ -247,15 +261,14 @@ def _cmd_follow(args) -> None:
 
 def _cmd_goal(args) -> None:
     from layered_swim.control.layered import Layers
-    from layered_swim.tasks import goal_run
+    from layered_swim.tasks import GOAL_METRICS, goal_run
 
     result = goal_run(args.pool, args.stroke, _vector(args.current, "--current"), Layers.parse(args.layers))
     if args.json:
         print(json.dumps(result, allow_nan=False))
         return
-    rows = [[f"goal y={g['goal_m'][1]:+.2f}"] + [f"{g[k]:.3f}" for k in ("pos_m", "prog", "dev_m", "roll_deg")]
-            for g in result["goals"]]
-    rows.append(["mean"] + [f"{result[k]:.3f}" for k in ("pos_m", "prog", "dev_m", "roll_deg")])
+    rows = [[f"goal y={g['goal_m'][1]:+.2f}"] + [f"{g[k]:.3f}" for k in GOAL_METRICS] for g in result["goals"]]
+    rows.append(["mean"] + [f"{result[k]:.3f}" for k in GOAL_METRICS])
     print(_table(rows, ["", "Pos m", "Prog", "Dev m", "Roll deg"]))
 
 
@@ -265,7 +278,7 @@ def _cmd_render(args) -> None:
 
     result = render(args.source, args.out, args.seconds, args.fps, _size(args.size), args.stroke, Layers.parse(args.layers),
                     _vector(args.current, "--current"), args.density, args.forces,
-                    progress=not args.no_progress and sys.stderr.isatty())
+                    progress=_progress(args))
     if not result["video"] and Path(args.out).suffix.lower() == ".mp4":
         print(f"{PROG}: note: {result['note']}", file=sys.stderr)
     print(f"wrote {result['frames']} frames to {result['out']}")
@@ -291,9 +304,10 @@ def _summary_rows(result: dict) -> list[list[str]]:
 
 def _cmd_analyze(args) -> None:
     from layered_swim.analysis.stroke_analysis import analyze_stroke, write_analysis
+    from layered_swim.runs import default_out_dir
 
     config = _analysis_config(args, args.stroke)
-    out = Path(args.out or Path("runs") / f"analyze-{Path(args.stroke).stem}-{time.strftime('%Y%m%d-%H%M%S')}")
+    out = Path(args.out or default_out_dir(f"analyze-{Path(args.stroke).stem}"))
     result = analyze_stroke(config, progress=not args.json and sys.stderr.isatty())
     files = write_analysis(result, out)
     if args.json:
@@ -306,13 +320,14 @@ def _cmd_analyze(args) -> None:
 def _cmd_compare(args) -> None:
     from layered_swim.analysis.stroke_analysis import write_comparison
     from layered_swim.config import ConfigError
+    from layered_swim.runs import default_out_dir
 
     strokes = [s.strip() for s in args.strokes.split(",") if s.strip()]
     if not strokes or len(set(strokes)) != len(strokes):
         raise ConfigError(f"--strokes must name one or more different strokes, got '{args.strokes}'")
     configs = [_analysis_config(args, stroke) for stroke in strokes]
-    out = Path(args.out or Path("runs") / f"compare-{time.strftime('%Y%m%d-%H%M%S')}")
-    results = write_comparison(configs, out, args.workers, progress=not args.no_progress and sys.stderr.isatty())
+    out = Path(args.out or default_out_dir("compare"))
+    results = write_comparison(configs, out, args.workers, progress=_progress(args))
     if args.json:
         print(json.dumps({r["stroke"]: r["summary"] for r in results} | {"out_dir": str(out)}, allow_nan=False))
         return
@@ -333,7 +348,7 @@ def _cmd_experiment(args) -> None:
     module = experiment(args.name)
     out = Path(args.out or Path("runs") / f"experiment-{args.name}")
     summary = run_experiment(module, out, quick=args.quick, workers=args.workers,
-                             progress=not args.no_progress and sys.stderr.isatty(), seed=args.seed)
+                             progress=_progress(args), seed=args.seed)
     if args.json:
         print(json.dumps({**summary, "out_dir": str(out)}, allow_nan=False))
         return
@@ -351,16 +366,22 @@ def main(argv: list[str] | None = None) -> int:
     in a subprocess, not inside a test runner that captures output."""
     _guard_stdout()
     args = _parser().parse_args(argv)
+    return report_errors(PROG, lambda: COMMANDS[args.command](args))
+
+
+def report_errors(prog: str, action) -> int:
+    """Run ``action``; bad input or a blown-up simulation is one line on stderr and exit code 2,
+    Ctrl-C is 130 (the CLI and app.py both end this way)."""
     from layered_swim.config import ConfigError
     from layered_swim.sim.simulation import SimulationDiverged  # imports PyBullet quietly (sim/world.py)
 
     try:
-        COMMANDS[args.command](args)
+        action()
     except (ConfigError, SimulationDiverged, OSError) as err:
-        print(f"{PROG}: error: {_one_line(err)}", file=sys.stderr)
+        print(f"{prog}: error: {_one_line(err)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"{PROG}: interrupted", file=sys.stderr)
+        print(f"{prog}: interrupted", file=sys.stderr)
         return 130
     return 0
 

@@ -79,7 +79,7 @@ def build_swim(stroke: str, lung_air_l: float | None = None, medium: Medium | No
     sim = Simulation(body, controller, medium if medium is not None else Medium(), SimConfig(physics_hz=physics_hz), layout=layout,
                      pd_gain_scale=parsed.pd_gain_scale)
     if layered:
-        controller.water_velocity = lambda state: sim.fluid.flow_at_swimmer(state.pos_m, state.quat_xyzw, state.linvel_m_s)
+        controller.water_velocity = lambda state: sim.fluid.flow_m_s   # found by this step's fluid call
         if target is not None:
             mass_fraction = body.mass_kg / body.mass_kg.sum()
             controller.desired_direction = lambda state: unit_vector(target.position(state.time_s) - mass_fraction @ state.pos_m)

@@ -25,13 +25,12 @@ def _induced_flow(v, axis, r_min, r_max, axial):
     return out
 
 
-def induced_flow(swimmer_velocity_m_s, pelvis_long_axis, r_min, r_max, axial=False):
+def induced_flow(swimmer_velocity_m_s, pelvis_long_axis, r_min, r_max):
     """Water velocity near the swimmer, V_F = ((r_max - r_min) sin^3(alpha) + r_min) V_S.
 
     alpha is the angle between V_S and the pelvis long axis (unit vector); |cos alpha|
     is used so moving backwards along the axis counts as along it. The sin^3 drop-off
     is that of a cylinder's drag coefficient (Hoerner). Zero velocity gives zero.
-    ``axial`` keeps only V_F's part along the axis (see ThinPlateFluid).
     """
     return _induced_flow(np.asarray(swimmer_velocity_m_s, dtype=np.float64),
-                         np.asarray(pelvis_long_axis, dtype=np.float64), float(r_min), float(r_max), bool(axial))
+                         np.asarray(pelvis_long_axis, dtype=np.float64), float(r_min), float(r_max), False)

@@ -39,12 +39,13 @@ def _fluid_wrenches(pos, quat, linvel, angvel, segments, medium, coefficients):
     half, semi, mass_fraction, volume = segments[:, 0:3], segments[:, 3:6], segments[:, 6], segments[:, 7]
     current = medium[0:3]
     r_min, r_max, axial, rho, eta, surface_z, g, exact, patches = medium[3:12]
+    water = _flow_at_swimmer(quat, linvel, mass_fraction, current, r_min, r_max, axial != 0.0)
     flow = np.empty((pos.shape[0], 3))
-    flow[:] = _flow_at_swimmer(quat, linvel, mass_fraction, current, r_min, r_max, axial != 0.0)
+    flow[:] = water
     force, torque = _plate_wrenches(pos, quat, linvel, angvel, half, flow, rho, eta, surface_z, coefficients[0],
                                     coefficients[1], coefficients[2], int(patches))
     b_force, b_torque = _buoyancy_wrenches(pos, quat, semi, volume, rho, g, surface_z, exact != 0.0)
-    return force + b_force, torque + b_torque, b_force
+    return force + b_force, torque + b_torque, b_force, water
 
 
 class ThinPlateFluid:
@@ -53,7 +54,6 @@ class ThinPlateFluid:
         self.medium = medium
         self.table = build_coefficient_table()
         self._mass_fraction = body.mass_kg / body.mass_kg.sum()
-        self._current = medium.current
         self._segments = np.ascontiguousarray(np.column_stack(
             [body.half_extents_m, body.semi_axes_m, self._mass_fraction, body.volume_m3]), dtype=np.float64)
         m = medium
@@ -64,6 +64,9 @@ class ThinPlateFluid:
         # The buoyancy part of the last ``wrenches`` force, for logs that separate it from the
         # hydrodynamic force (the part a stroke can change).
         self.buoyancy_force_n = np.zeros((len(body.segment_names), 3))
+        # The water velocity near the swimmer at the last ``wrenches`` (the controller's rules read
+        # it rather than computing it again); the current until the first step.
+        self.flow_m_s = medium.current
 
     def flow_at_swimmer(self, pos_m, quat_xyzw, linvel_m_s) -> np.ndarray:
         """Water velocity near the swimmer: the current plus the flow it drags along. Only motion
@@ -72,9 +75,9 @@ class ThinPlateFluid:
         weathervane drag that holds the body level when it pitches or yaws."""
         m = self.medium
         return _flow_at_swimmer(np.asarray(quat_xyzw, dtype=np.float64), np.asarray(linvel_m_s, dtype=np.float64),
-                                self._mass_fraction, self._current, m.r_min, m.r_max, m.axial_induced_flow)
+                                self._mass_fraction, m.current, m.r_min, m.r_max, m.axial_induced_flow)
 
     def wrenches(self, pos_m, quat_xyzw, linvel_m_s, angvel_rad_s) -> tuple[np.ndarray, np.ndarray]:
-        force, torque, self.buoyancy_force_n = _fluid_wrenches(pos_m, quat_xyzw, linvel_m_s, angvel_rad_s,
-                                                               self._segments, self._medium, self._coefficients)
+        force, torque, self.buoyancy_force_n, self.flow_m_s = _fluid_wrenches(
+            pos_m, quat_xyzw, linvel_m_s, angvel_rad_s, self._segments, self._medium, self._coefficients)
         return force, torque

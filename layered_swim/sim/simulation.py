@@ -128,11 +128,12 @@ class Simulation:
 
     def step(self) -> BodyState:
         state = self.state if self.state is not None else self.world.read_state()
+        # The fluid first: the controller's rules read the water velocity it found for this state.
+        force, torque = self.fluid.wrenches(state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s)
+        self.fluid_force_n = force
         if self.steps % self.control_every == 0:
             self.desired_pose, self.desired_rate = self.controller.desired(self.world.time_s, state)
             self.world.set_targets(self.desired_pose, self.desired_rate)
-        force, torque = self.fluid.wrenches(state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s)
-        self.fluid_force_n = force
         if self.external_force_n is not None:
             force = force + self.external_force_n
         self.world.apply_wrenches(force, torque, state.pos_m)
