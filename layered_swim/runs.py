@@ -72,7 +72,7 @@ def build_swim(stroke: str, lung_air_l: float | None = None, medium: Medium | No
         if policy is None:
             pace = tempo_control or TempoControl(min_tempo=parsed.steering.min_tempo,
                                                  glide_within_m=parsed.steering.glide_within_m)
-            policy = (TargetPolicy(target, load_table(parsed), parsed.start.posture, body.mass_kg / body.mass_kg.sum(),
+            policy = (TargetPolicy(target, load_table(parsed), parsed.start.posture, body.mass_fraction,
                                    tempo=pace)
                       if layers.cycle else fixed_weights({}, tempo=tempo))
         controller = LayeredController(parsed, layout, arm_indices(body, layout), policy, layers)
@@ -81,7 +81,7 @@ def build_swim(stroke: str, lung_air_l: float | None = None, medium: Medium | No
     if layered:
         controller.water_velocity = lambda state: sim.fluid.flow_m_s   # found by this step's fluid call
         if target is not None:
-            mass_fraction = body.mass_kg / body.mass_kg.sum()
+            mass_fraction = body.mass_fraction
             controller.desired_direction = lambda state: unit_vector(target.position(state.time_s) - mass_fraction @ state.pos_m)
     start = parsed.start
     sim.reset(start.posture, start.depth_m, start.speed_m_s)

@@ -51,7 +51,7 @@ def swim_toward(target: Target, stroke: str, seconds: float, layers: Layers, cur
     sim, start = setup.sim, setup.stroke.start
     speed = start.speed_m_s if start_speed is None else start_speed
     sim.reset(start.posture, start.depth_m, speed, position_xy_m=start_xy)
-    mass = sim.body.mass_kg / sim.body.mass_kg.sum()
+    mass = sim.body.mass_fraction
     posture = start.posture
     track = Track([], [], [], [], [])
     every = sim.config.physics_hz // TRACK_HZ
@@ -131,7 +131,7 @@ class ScheduledGoal:
         return bench.intermediate_goal(self.task, time_s, self.lead_s)
 
     def path_points(self, n: int = 400) -> np.ndarray:
-        return np.array([bench.goal_position(self.task, t) for t in np.linspace(0.0, self.task.duration_s, n)])
+        return bench.goal_position(self.task, np.linspace(0.0, self.task.duration_s, n))
 
 
 GOAL_METRICS = ("pos_m", "prog", "dev_m", "roll_deg")

@@ -17,7 +17,6 @@ from layered_swim.config import ConfigError
 # SWIM Table 3 starts the root at h_init = 0.45 m; read as height above the floor of the 0.5 m
 # training pool, that is 0.05 m under the surface. We use that depth in both pools.
 START_DEPTH_M = 0.05
-START_HEADING = (1.0, 0.0, 0.0)             # SWIM's "fixed initial state" faces the goals' side
 
 # SWIM's theta_tol is "style-specific, informed by the roll angles of elite swimmers" (eq. 14)
 # but never given. Front crawl: the low end of elite shoulder roll, 45-60 deg per side

@@ -164,6 +164,11 @@ class Body:
         return float(self.mass_kg.sum() + gimbals * self.gimbal_mass_kg)
 
     @property
+    def mass_fraction(self) -> np.ndarray:
+        """Each box's share of the boxes' mass: weights for the centre of mass of the segments."""
+        return self.mass_kg / self.mass_kg.sum()
+
+    @property
     def total_volume_m3(self) -> float:
         return float(self.volume_m3.sum())
 

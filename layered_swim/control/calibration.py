@@ -24,6 +24,7 @@ from layered_swim.control.stroke import SEQUENCE_NAMES, STROKES_DIR, Stroke
 CALIBRATION_DIR = STROKES_DIR / "calibration"
 SEQUENCE_AXIS = {"yaw_left": ("yaw", 1.0), "yaw_right": ("yaw", -1.0), "pitch_up": ("pitch", 1.0),
                  "pitch_down": ("pitch", -1.0), "roll_left": ("roll", 1.0), "roll_right": ("roll", -1.0)}
+AXIS_INDEX = {"yaw": 0, "pitch": 1, "roll": 2}       # columns of a swim's (yaw, pitch, roll) change
 WEIGHTS = (0.0, 0.25, 0.5, 0.75, 1.0)
 TEMPOS = (0.7, 1.0)
 SETTLE_CYCLES = 3
@@ -125,7 +126,7 @@ def _measure(job: tuple[str, str | None, float, float]) -> tuple:
     """One calibration swim: (angle change per cycle about the sequence's axis, mean speed, the
     last cycle's mean roll); with no sequence the change is (yaw, pitch, roll)."""
     from layered_swim.control.layered import Layers, fixed_weights
-    from layered_swim.control.steering import attitude
+    from layered_swim.control.steering import attitude, wrap_angle
     from layered_swim.runs import build_swim
 
     stroke_name, sequence, weight, tempo = job
@@ -135,7 +136,7 @@ def _measure(job: tuple[str, str | None, float, float]) -> tuple:
     posture = setup.stroke.start.posture
     samples: dict[int, list[tuple[float, float, float]]] = {}
     heading_prev, unwrapped = None, 0.0
-    mass = sim.body.mass_kg / sim.body.mass_kg.sum()
+    mass = sim.body.mass_fraction
     positions = []
 
     def record(s) -> None:
@@ -144,7 +145,7 @@ def _measure(job: tuple[str, str | None, float, float]) -> tuple:
             return
         att = attitude(s.state.quat_xyzw[0], s.state.quat_xyzw[2], posture)
         if heading_prev is not None:
-            unwrapped += (att.heading_rad - heading_prev + math.pi) % (2 * math.pi) - math.pi
+            unwrapped += wrap_angle(att.heading_rad - heading_prev)
         heading_prev = att.heading_rad
         samples.setdefault(controller.cycle, []).append((unwrapped, att.pitch_rad, -att.roll_rad))
         if controller.cycle >= SETTLE_CYCLES:
@@ -157,7 +158,7 @@ def _measure(job: tuple[str, str | None, float, float]) -> tuple:
         sim.close()
     before = np.mean(samples[SETTLE_CYCLES - 1], axis=0)
     after = np.mean(samples[SETTLE_CYCLES + MEASURE_CYCLES - 1], axis=0)
-    axis = {"yaw": 0, "pitch": 1, "roll": 2}[SEQUENCE_AXIS[sequence][0]] if sequence else 0
+    axis = AXIS_INDEX[SEQUENCE_AXIS[sequence][0]] if sequence else 0
     change = (after - before) / MEASURE_CYCLES
     track = np.array(positions)
     speed = float(np.linalg.norm(track[-1, :2] - track[0, :2]) / (len(track) / sim.config.control_hz))
@@ -184,7 +185,7 @@ def calibrate(stroke: Stroke, weights=WEIGHTS, tempos=TEMPOS, workers: int = 2, 
     turn_rad = {}
     for seq in sequences:
         axis, sign = SEQUENCE_AXIS[seq]
-        k = {"yaw": 0, "pitch": 1, "roll": 2}[axis]
+        k = AXIS_INDEX[axis]
         rows = []
         for tempo in tempos:
             rows.append([0.0] + [sign * (next(measured)[0] - baseline[tempo][k]) for w in weights if w > 0])

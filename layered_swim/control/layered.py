@@ -62,11 +62,12 @@ class WeightPolicy(Protocol):
 
 class LayeredController:
     def __init__(self, stroke: Stroke, layout: JointLayout, arms: list[ArmIndices], policy: WeightPolicy,
-                 layers: Layers = Layers(), water_velocity: Callable[[BodyState], np.ndarray] | None = None,
-                 desired_direction: Callable[[BodyState], np.ndarray] | None = None):
+                 layers: Layers = Layers()):
         self.stroke, self.layout, self.arms, self.policy, self.layers = stroke, layout, arms, policy, layers
-        self.water_velocity = water_velocity
-        self.desired_direction = desired_direction
+        # Set by whoever builds the swim (runs.build_swim): the water velocity near the swimmer and
+        # the unit direction it should go; without them the rules stay off.
+        self.water_velocity: Callable[[BodyState], np.ndarray] | None = None
+        self.desired_direction: Callable[[BodyState], np.ndarray] | None = None
         self.reset()
 
     def reset(self) -> None:
@@ -89,7 +90,7 @@ class LayeredController:
             return float(self.cycle)
         return self.cycle + (time_s - self.cycle_start_s) * self.cycles_per_s
 
-    def _start_cycle(self, time_s: float, state: BodyState | None) -> None:
+    def _start_cycle(self, state: BodyState | None) -> None:
         if self.cycle >= 0:
             self.cycle_start_s += 1.0 / self.cycles_per_s
         self.cycle += 1
@@ -104,7 +105,7 @@ class LayeredController:
 
     def desired(self, time_s: float, state: BodyState | None) -> tuple[np.ndarray, np.ndarray]:
         while self.cycle < 0 or (time_s - self.cycle_start_s) * self.cycles_per_s >= 1.0:
-            self._start_cycle(time_s, state)
+            self._start_cycle(state)
         phase = self.phase(time_s)
         pose, rate = self.stroke.pose(phase)
         if self.choice.glide:

@@ -87,10 +87,6 @@ class TrajectoryTarget:
         """Seconds for one pass along the whole path (one lap when looping)."""
         return self._period / self._rate
 
-    @property
-    def length_m(self) -> float:
-        return float(np.linalg.norm(self._steps, axis=1).sum())
-
     def position(self, time_s: float) -> np.ndarray:
         u = self._rate * (time_s + self.start_s)
         u = u % self._period if self.loop else min(max(u, 0.0), self._period)

@@ -53,7 +53,7 @@ class ThinPlateFluid:
         self.body = body
         self.medium = medium
         self.table = build_coefficient_table()
-        self._mass_fraction = body.mass_kg / body.mass_kg.sum()
+        self._mass_fraction = body.mass_fraction
         self._segments = np.ascontiguousarray(np.column_stack(
             [body.half_extents_m, body.semi_axes_m, self._mass_fraction, body.volume_m3]), dtype=np.float64)
         m = medium

@@ -114,7 +114,7 @@ class SwimSession:
         self.sim.reset(start.posture, start.depth_m, start.speed_m_s if use_start_speed else 0.0,
                        heading_rad=heading_rad, position_xy_m=position_xy_m)
         self._apply_layers()
-        self._mass_fraction = self.sim.body.mass_kg / self.sim.body.mass_kg.sum()
+        self._mass_fraction = self.sim.body.mass_fraction
         self.trail: deque = deque(maxlen=TRAIL_POINTS)
         self._next_trail_s = 0.0
         self._accumulator_s = 0.0

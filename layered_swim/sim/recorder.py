@@ -61,7 +61,7 @@ class Recorder:
         self.segment_names = body.segment_names
         self.joint_names = joint_position_names(sim.layout)
         self.pose_names = sim.layout.names
-        self._mass_fraction = body.mass_kg / body.mass_kg.sum()
+        self._mass_fraction = body.mass_fraction
         self._head = body.index("head")
         self._head_half_z_m = float(body.half_extents_m[self._head, 2])
         self._rows: dict[str, list] = {name: [] for name in ARRAY_NAMES if name != "head_top_m"}
