@@ -8,8 +8,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-DATA_SHEET = "data sheet section 3"
-
 
 @dataclass(frozen=True)
 class Range:

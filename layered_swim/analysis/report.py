@@ -22,7 +22,6 @@ QUANTITIES = {
     "mechanical_power_w": ("mechanical power of the joint torques", "W", "{:.0f}"),
     "propelling_efficiency": ("propelling efficiency", "-", "{:.3f}"),
 }
-SUMMARY_ROWS = tuple(QUANTITIES)
 
 DEFINITIONS = """\
 - **Cycles** start when the cycle marker rises through its mean: for prone strokes how far the
@@ -118,7 +117,7 @@ def compare_report(results: list[dict], tables: list[list[dict]], figure_file: s
              "Each cell: ours (mean +- SD over cycles) and, in brackets, the verdict against the real "
              "swimmers' range for that stroke (data sheet section 3; '-' where it gives none).", "",
              "| quantity | " + " | ".join(strokes) + " |", "|---|" + "---|" * len(strokes)]
-    for name in SUMMARY_ROWS:
+    for name in QUANTITIES:
         cells = []
         for rows in by_stroke:
             row = rows.get(name)

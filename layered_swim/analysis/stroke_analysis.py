@@ -65,7 +65,7 @@ def comparisons(result: dict) -> list[dict]:
     summary = result["summary"]
     ranges = ranges_for(result["stroke"], summary["mean_speed_m_s"]["mean"])
     rows = []
-    for name in report.SUMMARY_ROWS:
+    for name in report.QUANTITIES:
         value = summary.get(name)
         if value is None:
             continue

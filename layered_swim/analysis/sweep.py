@@ -23,6 +23,7 @@ PACKAGE_DIR = Path(__file__).resolve().parents[1]
 DEFAULT_WORKERS = 2     # the machines this project runs on have two cores
 # Modules that only present results: editing a plot or a report must not throw the cache away.
 PRESENTATION_ONLY = {"cli.py", "analysis/plots.py", "analysis/report.py", "analysis/files.py", "analysis/sweep.py"}
+PRESENTATION_DIRS = ("render/",)   # the window and the video renderer draw runs, never change them
 # One module per experiment: each task's own module joins its key, so editing one experiment
 # recomputes that experiment only.
 TASK_MODULES = "analysis/experiments/"
@@ -42,7 +43,7 @@ def code_sha256() -> str:
 
 
 def _presentation_or_task(relative: str) -> bool:
-    return relative in PRESENTATION_ONLY or relative.startswith(TASK_MODULES)
+    return relative in PRESENTATION_ONLY or relative.startswith((*PRESENTATION_DIRS, TASK_MODULES))
 
 
 def file_sha256(path: str | Path) -> str:

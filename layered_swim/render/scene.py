@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from layered_swim.control.pose import quat_rotate
+
 SKIN = (0.93, 0.72, 0.58)
 SUIT = (0.75, 0.12, 0.16)
 CAP = (1.0, 0.82, 0.15)
@@ -78,21 +80,11 @@ def segment_colors(names: tuple[str, ...]) -> np.ndarray:
     return np.array(colors)
 
 
-def rotation_matrices(quat_xyzw: np.ndarray) -> np.ndarray:
-    x, y, z, w = np.moveaxis(np.asarray(quat_xyzw, float), -1, 0)
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
-    ], -2)
-
-
 def box_triangles(pos_m: np.ndarray, quat_xyzw: np.ndarray, half_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Vertices and normals (n * 36, 3) of every segment's box, in segment order."""
-    rot = rotation_matrices(quat_xyzw)
-    local = BOX_CORNERS[None, :, :] * half_m[:, None, :]
-    vertices = pos_m[:, None, :] + np.einsum("sij,svj->svi", rot, local)
-    normals = np.einsum("sij,vj->svi", rot, BOX_NORMALS)
+    quat = np.asarray(quat_xyzw, float)[:, None, :]
+    vertices = pos_m[:, None, :] + quat_rotate(quat, BOX_CORNERS[None, :, :] * half_m[:, None, :])
+    normals = quat_rotate(quat, BOX_NORMALS[None, :, :])
     return vertices.reshape(-1, 3), normals.reshape(-1, 3)
 
 

@@ -16,13 +16,15 @@ from layered_swim.control.calibration import CalibrationError
 from layered_swim.control.layered import Layers
 from layered_swim.control.steering import attitude
 from layered_swim.control.stroke import available_strokes, stroke_path
-from layered_swim.control.targets import MovableTarget, Target, TrajectoryTarget, load_trajectory
+from layered_swim.control.targets import MovableTarget, TrajectoryTarget, load_trajectory
+from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S
 from layered_swim.runs import build_swim, make_medium
 from layered_swim.sim.simulation import SimulationDiverged
 
 CURRENT_PRESETS_M_S = (("none", (0.0, 0.0, 0.0)), ("0.3 m/s cross", (0.0, 0.3, 0.0)),
                        ("0.5 m/s head-on", (-0.5, 0.0, 0.0)))
-DENSITY_PRESETS_KG_M3 = (("fresh water", 997.05), ("seawater", 1023.3), ("light fluid", 800.0),
+DENSITY_PRESETS_KG_M3 = (("fresh water", PRESETS_KG_M3_PA_S["fresh_water"][0]),
+                         ("seawater", PRESETS_KG_M3_PA_S["seawater"][0]), ("light fluid", 800.0),
                          ("dense fluid", 1500.0))
 SLOW_MOTION = 0.25
 MAX_LAG_S = 0.1            # simulated time a frame may owe; beyond it the sim slows instead of spiralling

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
@@ -61,8 +60,8 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
         ax.legend(loc="best", fontsize="small")
     plots.save(fig, out_dir / FIGURE)
     seconds = configs[0]["seconds"]
-    tw, bs = (final[("treading_water", p)] for p in (False, True)), (final[("breaststroke", p)] for p in (False, True))
-    (tw_off, tw_on), (bs_off, bs_on) = tuple(tw), tuple(bs)
+    tw_off, tw_on = final[("treading_water", False)], final[("treading_water", True)]
+    bs_off, bs_on = final[("breaststroke", False)], final[("breaststroke", True)]
     gain = 100.0 * (bs_on - bs_off) / abs(bs_off)
     helps_treading = tw_on > tw_off
     ours = (f"Treading water: in {seconds:g} s the pelvis moves {tw_on:+.2f} m along the direction of the target with "
