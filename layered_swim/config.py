@@ -65,3 +65,20 @@ def parse(model: type[Model], data: Any, source: str | Path) -> Model:
 
 def load(model: type[Model], path: str | Path) -> Model:
     return parse(model, load_yaml(path), path)
+
+
+def available_files(directory: Path) -> list[str]:
+    """The bare names of the YAML files shipped in ``directory``."""
+    return sorted(p.stem for p in directory.glob("*.yaml"))
+
+
+def file_path(name_or_path: str | Path, directory: Path, kind: str) -> Path:
+    """A ``kind`` file (stroke, trajectory) by path (anything ending in .yaml/.yml) or by bare
+    name in ``directory``; an unknown name is an error listing the known ones."""
+    candidate = Path(name_or_path)
+    if candidate.suffix in (".yaml", ".yml"):
+        return candidate
+    path = directory / f"{name_or_path}.yaml"
+    if not path.exists():
+        raise ConfigError(f"unknown {kind} '{name_or_path}' (available: {', '.join(available_files(directory))})")
+    return path

@@ -13,6 +13,7 @@ from pathlib import Path
 from layered_swim.analysis import plots, report
 from layered_swim.analysis.drag import towed_drag
 from layered_swim.analysis.files import write_csv
+from layered_swim.analysis.metrics import SETTLE_S
 from layered_swim.analysis.reference_ranges import ranges_for
 from layered_swim.analysis.stroke_metrics import SwimmerInfo, analyze_log
 from layered_swim.analysis.sweep import file_sha256, run_sweep
@@ -22,13 +23,12 @@ from layered_swim.runs import _check_seconds, _run, _write_json, build_swim, mak
 from layered_swim.sim.recorder import Recorder
 
 ANALYSIS_LOG_HZ = 120      # ~100 samples per stroke cycle for the profiles
-DEFAULT_SETTLE_S = 5.0
 PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_figure,
          "propulsion_power.png": plots.propulsion_figure, "attitude.png": plots.attitude_figure}
 
 
 def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | None = None,
-                    current_m_s=(0.0, 0.0, 0.0), fluid: str = "fresh_water", settle_s: float = DEFAULT_SETTLE_S,
+                    current_m_s=(0.0, 0.0, 0.0), fluid: str = "fresh_water", settle_s: float = SETTLE_S,
                     seed: int = 0, physics_hz: int = 480) -> dict:
     """The resolved, JSON-able configuration of one analysis (also its cache key)."""
     _check_seconds(seconds)

@@ -18,7 +18,7 @@ import numpy as np
 from pydantic import Field, PositiveFloat, model_validator
 from scipy.interpolate import PchipInterpolator
 
-from layered_swim.config import ConfigError, Strict, load
+from layered_swim.config import ConfigError, Strict, available_files, file_path, load
 from layered_swim.control.pose import JointLayout
 
 STROKES_DIR = Path(__file__).resolve().parents[2] / "strokes"
@@ -244,17 +244,11 @@ def _coord(layout: JointLayout, joints: set[str], joint: str, axis: str, where: 
 
 
 def available_strokes(directory: Path = STROKES_DIR) -> list[str]:
-    return sorted(p.stem for p in directory.glob("*.yaml"))
+    return available_files(directory)
 
 
 def stroke_path(name_or_path: str, directory: Path = STROKES_DIR) -> Path:
-    candidate = Path(name_or_path)
-    if candidate.suffix in (".yaml", ".yml"):
-        return candidate
-    path = directory / f"{name_or_path}.yaml"
-    if not path.exists():
-        raise ConfigError(f"unknown stroke '{name_or_path}' (available: {', '.join(available_strokes(directory))})")
-    return path
+    return file_path(name_or_path, directory, "stroke")
 
 
 def load_stroke(name_or_path: str, layout: JointLayout, directory: Path = STROKES_DIR) -> Stroke:

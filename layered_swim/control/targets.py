@@ -18,7 +18,7 @@ from typing import Any, Literal, Protocol, runtime_checkable
 import numpy as np
 from pydantic import Field, NonNegativeFloat, PositiveFloat
 
-from layered_swim.config import ConfigError, Strict, load_yaml, parse
+from layered_swim.config import ConfigError, Strict, available_files, file_path, load_yaml, parse
 
 TRAJECTORIES_DIR = Path(__file__).resolve().parents[2] / "trajectories"
 CURVE_SAMPLES = 4096          # samples per closed curve (figure eight, circle)
@@ -253,18 +253,11 @@ def parse_trajectory(data: Any, source: str | Path) -> Strict:
 
 
 def available_trajectories(directory: Path = TRAJECTORIES_DIR) -> list[str]:
-    return sorted(p.stem for p in directory.glob("*.yaml"))
+    return available_files(directory)
 
 
 def trajectory_path(name_or_path: str | Path, directory: Path = TRAJECTORIES_DIR) -> Path:
-    candidate = Path(name_or_path)
-    if candidate.suffix in (".yaml", ".yml"):
-        return candidate
-    path = directory / f"{name_or_path}.yaml"
-    if not path.exists():
-        raise ConfigError(f"unknown trajectory '{name_or_path}' "
-                          f"(available: {', '.join(available_trajectories(directory))})")
-    return path
+    return file_path(name_or_path, directory, "trajectory")
 
 
 def load_trajectory(name_or_path: str | Path, directory: Path = TRAJECTORIES_DIR) -> TrajectoryTarget:

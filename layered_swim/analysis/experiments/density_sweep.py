@@ -10,6 +10,7 @@ from matplotlib.ticker import FormatStrFormatter
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
 from layered_swim.analysis.files import write_csv
+from layered_swim.analysis.metrics import SETTLE_S
 from layered_swim.control.layered import Layers
 from layered_swim.control.targets import load_trajectory
 from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S
@@ -28,7 +29,6 @@ STROKE = "breaststroke"
 TRAJECTORY = "straight_line"
 DENSITIES_KG_M3 = (500.0, 750.0, 920.0, 997.05, 1100.0, 1250.0, 1500.0, 2000.0, 2500.0)
 QUICK_DENSITIES_KG_M3 = (500.0, 997.05, 1500.0, 2500.0)
-SETTLE_S = 5.0
 FAIL_DISTANCE_M = 2.0      # tracking fails: mean distance to the target over the run's second half above this
 SWIM_SUCCESS_KG_M3 = (920.0, 1500.0)
 TARGET_DEPTH_M = 0.3       # the straight_line trajectory's depth
