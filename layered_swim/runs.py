@@ -23,6 +23,7 @@ from layered_swim.control.layered import Layers, LayeredController, WeightPolicy
 from layered_swim.control.policy import TargetPolicy, TempoControl
 from layered_swim.control.pose import joint_layout, unit_vector
 from layered_swim.control.rules import arm_indices
+from layered_swim.control.steering import SteeringGains
 from layered_swim.control.targets import Target
 from layered_swim.control.stroke import Stroke, StrokeSpec, available_strokes, build_stroke, stroke_path
 from layered_swim.fluid.medium import Medium, preset
@@ -70,10 +71,11 @@ def build_swim(stroke: str, lung_air_l: float | None = None, medium: Medium | No
         controller = StrokeController(parsed, tempo)
     else:
         if policy is None:
-            pace = tempo_control or TempoControl(min_tempo=parsed.steering.min_tempo,
-                                                 glide_within_m=parsed.steering.glide_within_m)
+            steer = parsed.steering
+            pace = tempo_control or TempoControl(min_tempo=steer.min_tempo, glide_within_m=steer.glide_within_m)
+            gains = SteeringGains(steer.yaw_fraction, steer.pitch_fraction, steer.roll_fraction)
             policy = (TargetPolicy(target, load_table(parsed), parsed.start.posture, body.mass_fraction,
-                                   tempo=pace)
+                                   gains=gains, tempo=pace)
                       if layers.cycle else fixed_weights({}, tempo=tempo))
         controller = LayeredController(parsed, layout, arm_indices(body, layout), policy, layers)
     sim = Simulation(body, controller, medium if medium is not None else Medium(), SimConfig(physics_hz=physics_hz), layout=layout,

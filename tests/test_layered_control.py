@@ -5,13 +5,14 @@ import numpy as np
 import pytest
 
 from layered_swim.body.model import load_body
-from layered_swim.config import ConfigError
+from layered_swim.config import ConfigError, load
 from layered_swim.control.calibration import CalibrationTable, load_table
-from layered_swim.control.layered import Layers, LayeredController, fixed_weights
+from layered_swim.control.layered import CycleChoice, Layers, LayeredController, fixed_weights
 from layered_swim.control.pose import joint_layout, quat_multiply
 from layered_swim.control.rules import arm_indices, rule_offsets
 from layered_swim.control.steering import Attitude, wanted_turns
-from layered_swim.control.stroke import JointKeys, RulesSpec, StrokeSpec, build_stroke, load_stroke, mirrored_keys
+from layered_swim.control.stroke import (JointKeys, RulesSpec, StrokeSpec, build_stroke, load_stroke, mirrored_keys,
+                                         stroke_path)
 from layered_swim.control.policy import Lead, TargetPolicy, TempoControl
 from layered_swim.control.targets import FixedTarget, load_trajectory
 from layered_swim.runs import build_swim
@@ -90,6 +91,38 @@ def test_blending_adds_weighted_offsets_for_the_whole_cycle():
     offset, _ = stroke.perturbations["yaw_left"].at(1.3)
     np.testing.assert_allclose(pose, LAYOUT.clamp(basic + 0.5 * offset))
     assert controller.choice.weights == {"yaw_left": 0.5}
+
+
+def test_glide_holds_the_pose_but_the_joints_that_keep_moving():
+    stroke = load_stroke("front_crawl", LAYOUT)
+    moving = stroke.glide_moving
+    assert moving[LAYOUT.index("knee_l.flexion")] and not moving[LAYOUT.index("shoulder_l.flexion")]
+
+    def glide(cycle, state, mean_roll_rad):
+        return CycleChoice(glide=True)
+    controller = LayeredController(stroke, LAYOUT, arm_indices(BODY, LAYOUT), glide, Layers(cycle=True, palm=False, reach=False))
+    state = BodyState(0.0, np.zeros((16, 3)), np.tile(PRONE_QUAT_XYZW, (16, 1)), np.zeros((16, 3)), np.zeros((16, 3)))
+    pose, rate = controller.desired(0.0, state)
+    state.time_s = 0.3 * stroke.period_s
+    pose, rate = controller.desired(state.time_s, state)
+    held, _ = stroke.pose(0.0)
+    running, running_rate = stroke.pose(0.3)
+    np.testing.assert_allclose(pose[~moving], LAYOUT.clamp(held)[~moving])       # the arms wait
+    np.testing.assert_allclose(pose[moving], LAYOUT.clamp(running)[moving])      # the legs kick on
+    assert np.all(rate[~moving] == 0.0)
+    np.testing.assert_allclose(rate[moving], running_rate[moving] / stroke.period_s)
+    assert np.ptp(running[moving]) > 0.05     # they do move
+
+
+def test_steering_settings_come_from_the_stroke_file_and_leave_its_calibration_fresh():
+    crawl = build_swim("front_crawl", target=FixedTarget([5.0, 0.0, -0.3]))
+    steering = crawl.stroke.steering
+    gains = crawl.sim.controller.policy.gains
+    assert (gains.yaw_fraction, gains.pitch_fraction, gains.roll_fraction) == (
+        steering.yaw_fraction, steering.pitch_fraction, steering.roll_fraction)
+    spec = load(StrokeSpec, stroke_path("front_crawl"))
+    edited = spec.model_copy(update={"steering": spec.steering.model_copy(update={"yaw_fraction": 0.1})})
+    assert build_stroke(edited, LAYOUT, "x").spec_sha256 == crawl.stroke.spec_sha256
 
 
 def _facing_change(arm, offsets, quat, flow_dir):

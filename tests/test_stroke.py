@@ -82,6 +82,8 @@ def test_shipped_strokes_load(name):
     (GOOD.replace("period_s: 1.5\n", ""), ["period_s"]),
     (GOOD.replace("period_s: 1.5", "period_s: -1"), ["period_s"]),
     (GOOD.replace("flexion: {0.0: 0, 0.5: 145}", "flexion: {0.0: 0, 0.5: 145"), ["line"]),
+    (GOOD + "steering: {glide_moving_joints: [hip_l, tail]}\n", ["steering.glide_moving_joints", "tail"]),
+    (GOOD + "steering: {yaw_fraction: 1.5}\n", ["steering.yaw_fraction"]),
 ])
 def test_bad_stroke_file(tmp_path, text, words):
     path = write(tmp_path, text, "bad.yaml")

@@ -52,7 +52,7 @@ class CycleChoice:
 
     weights: dict[str, float] = field(default_factory=dict)
     tempo: float = 1.0
-    glide: bool = False      # hold the cycle's first pose for one period instead of stroking
+    glide: bool = False      # hold the cycle's first pose for one period (but the stroke's glide_moving_joints)
     thrust_demand: float = 1.0   # 0..1: how much more force the rules should seek this cycle
 
 
@@ -109,7 +109,11 @@ class LayeredController:
         phase = self.phase(time_s)
         pose, rate = self.stroke.pose(phase)
         if self.choice.glide:
-            rate = np.zeros_like(rate)
+            # Held but for the joints the stroke keeps moving through a glide (its kick).
+            running, running_rate = self.stroke.pose(self.cycle + (time_s - self.cycle_start_s) * self.cycles_per_s)
+            moving = self.stroke.glide_moving
+            pose = np.where(moving, running, pose)
+            rate = np.where(moving, running_rate, 0.0)
         for name, weight in self._blended_weights(time_s).items():
             if weight:
                 offset, offset_rate = self.stroke.perturbations[name].at(phase)

@@ -70,11 +70,17 @@ class RulesSpec(Strict):
 
 
 class SteeringSpec(Strict):
-    """How the per-cycle layer may change the stroke's pace: tempo down to ``min_tempo`` (below
-    it the stroke stops working), and gliding for a cycle when closer than ``glide_within_m``."""
+    """How the per-cycle layer steers this stroke: the share of each error it corrects in one
+    cycle, tempo down to ``min_tempo`` (below it the stroke stops working), and gliding for a
+    cycle when closer than ``glide_within_m``, with ``glide_moving_joints`` still stroking
+    (a crawl's legs keep kicking in a glide, or they sink)."""
 
+    yaw_fraction: float = Field(0.7, ge=0.0, le=1.0)
+    pitch_fraction: float = Field(0.5, ge=0.0, le=1.0)
+    roll_fraction: float = Field(0.5, ge=0.0, le=1.0)
     min_tempo: float = Field(0.5, ge=0.1, le=1.0)
     glide_within_m: float = Field(0.0, ge=0.0, le=10.0)
+    glide_moving_joints: list[str] = []
 
 
 class StrokeSpec(Strict):
@@ -116,6 +122,7 @@ class Stroke:
     perturbations: dict[str, CyclicTable]    # offsets over one cycle at weight 1, rad
     rules: RulesSpec
     steering: SteeringSpec
+    glide_moving: np.ndarray                 # (n,) bool: pose coordinates that keep stroking in a glide
     pd_gain_scale: dict[str, float]
     source: str
     spec_sha256: str                         # of the parsed file: calibration tables check it
@@ -228,9 +235,14 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
     for joint in spec.pd_gain_scale:
         if joint not in joints:
             raise ConfigError(f"{source}: field 'pd_gain_scale.{joint}': unknown joint")
-    digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json"), sort_keys=True).encode()).hexdigest()
+    for joint in spec.steering.glide_moving_joints:
+        if joint not in joints:
+            raise ConfigError(f"{source}: field 'steering.glide_moving_joints': unknown joint '{joint}'")
+    glide_moving = np.array([name.split(".")[0] in spec.steering.glide_moving_joints for name in layout.names])
+    # What calibration measures: the steering settings only read its table, so they stay out.
+    digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude={"steering"}), sort_keys=True).encode()).hexdigest()
     return Stroke(spec.name, spec.description, spec.period_s, spec.start, basic, perturbations, spec.rules,
-                  spec.steering, dict(spec.pd_gain_scale), source, digest)
+                  spec.steering, glide_moving, dict(spec.pd_gain_scale), source, digest)
 
 
 def _coord(layout: JointLayout, joints: set[str], joint: str, axis: str, where: str) -> int:
