@@ -125,7 +125,7 @@ class Stroke:
     glide_moving: np.ndarray                 # (n,) bool: pose coordinates that keep stroking in a glide
     pd_gain_scale: dict[str, float]
     source: str
-    spec_sha256: str                         # of the parsed file: calibration tables check it
+    spec_sha256: str                         # of the parsed file less its steering: calibration tables check it
 
     @property
     def table(self) -> np.ndarray:
