@@ -141,12 +141,8 @@ def run_swim(stroke: str, seconds: float = 30.0, lung_air_l: float | None = None
     _check_seconds(seconds)
     setup = build_swim(stroke, lung_air_l, make_medium(fluid, density), physics_hz, tempo, seed)
     sim = setup.sim
-    try:
-        recorder = Recorder(sim, log_hz)
-        out_dir.mkdir(parents=True, exist_ok=True)
-        _run(sim, seconds, recorder, progress)
-    finally:
-        sim.close()
+    recorder = record(sim, seconds, log_hz, progress)
+    out_dir.mkdir(parents=True, exist_ok=True)
     a = recorder.arrays()
     result = summary(a["time_s"], a["com_pos_m"], a["root_pos_m"],
                      a["segment_quat_xyzw"][:, sim.body.index("thorax")], a["head_top_m"],
@@ -157,19 +153,27 @@ def run_swim(stroke: str, seconds: float = 30.0, lung_air_l: float | None = None
     return result
 
 
-def _run(sim: Simulation, seconds: float, recorder: Recorder, progress: bool) -> None:
-    if not progress:
-        sim.run(seconds, every_step=recorder)
-        return
-    from tqdm import tqdm
+def record(sim: Simulation, seconds: float, log_hz: int = DEFAULT_LOG_HZ, progress: bool = False,
+           joint_work: bool = False) -> Recorder:
+    """Run ``sim`` for ``seconds`` logging at ``log_hz`` (a progress bar with ``progress``),
+    close it, and return the log."""
+    try:
+        recorder = Recorder(sim, log_hz, joint_work=joint_work)
+        if not progress:
+            sim.run(seconds, every_step=recorder)
+            return recorder
+        from tqdm import tqdm
 
-    hz = sim.config.physics_hz
-    with tqdm(total=math.floor(seconds), desc="simulated seconds", unit="s", leave=False) as bar:
-        def every_step(s: Simulation) -> None:
-            recorder(s)
-            if s.steps % hz == 0:
-                bar.update(1)
-        sim.run(seconds, every_step=every_step)
+        hz = sim.config.physics_hz
+        with tqdm(total=math.floor(seconds), desc="simulated seconds", unit="s", leave=False) as bar:
+            def every_step(s: Simulation) -> None:
+                recorder(s)
+                if s.steps % hz == 0:
+                    bar.update(1)
+            sim.run(seconds, every_step=every_step)
+        return recorder
+    finally:
+        sim.close()
 
 
 def _check_seconds(seconds: float) -> None:

@@ -19,8 +19,7 @@ from layered_swim.analysis.stroke_metrics import SwimmerInfo, analyze_log
 from layered_swim.analysis.sweep import file_sha256, run_sweep
 from layered_swim.config import ConfigError
 from layered_swim.control.stroke import stroke_path
-from layered_swim.runs import _check_seconds, _run, _write_json, build_swim, make_medium, resolved_config
-from layered_swim.sim.recorder import Recorder
+from layered_swim.runs import _check_seconds, _write_json, build_swim, make_medium, record, resolved_config
 
 ANALYSIS_LOG_HZ = 120      # ~100 samples per stroke cycle for the profiles
 PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_figure,
@@ -43,11 +42,7 @@ def analyze_stroke(config: dict, progress: bool = False) -> dict:
     medium = make_medium(config["fluid"], config["density_kg_m3"]).with_(current_m_s=tuple(config["current_m_s"]))
     setup = build_swim(config["stroke"], medium=medium, physics_hz=config["physics_hz"], seed=config["seed"])
     sim = setup.sim
-    try:
-        recorder = Recorder(sim, ANALYSIS_LOG_HZ, joint_work=True)
-        _run(sim, config["seconds"], recorder, progress)
-    finally:
-        sim.close()
+    recorder = record(sim, config["seconds"], ANALYSIS_LOG_HZ, progress, joint_work=True)
     posture = setup.stroke.start.posture
     result = analyze_log(recorder.arrays(), SwimmerInfo(sim.body.segment_names, posture, setup.stroke.period_s,
                                                         config["settle_s"]))

@@ -7,16 +7,15 @@ water flowing past the hands. Layers can be switched off one by one (``Layers``)
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Callable, Protocol
 
 import numpy as np
 
 from layered_swim.config import ConfigError
-from layered_swim.control.pose import JointLayout, quat_rotate
+from layered_swim.control.pose import JointLayout
 from layered_swim.control.rules import ArmIndices, rule_offsets
-from layered_swim.control.steering import FORWARD_LOCAL, LATERAL_LOCAL
+from layered_swim.control.steering import forward_axis, shoulder_roll
 from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
 from layered_swim.sim.world import BodyState
 
@@ -86,8 +85,10 @@ class LayeredController:
         return self.choice.tempo / self.stroke.period_s
 
     def phase(self, time_s: float) -> float:
-        if self.choice.glide:
-            return float(self.cycle)
+        """The stroke's phase in cycles; a glide holds its cycle's start."""
+        return float(self.cycle) if self.choice.glide else self._running_phase(time_s)
+
+    def _running_phase(self, time_s: float) -> float:
         return self.cycle + (time_s - self.cycle_start_s) * self.cycles_per_s
 
     def _start_cycle(self, state: BodyState | None) -> None:
@@ -110,7 +111,7 @@ class LayeredController:
         pose, rate = self.stroke.pose(phase)
         if self.choice.glide:
             # Held but for the joints the stroke keeps moving through a glide (its kick).
-            running, running_rate = self.stroke.pose(self.cycle + (time_s - self.cycle_start_s) * self.cycles_per_s)
+            running, running_rate = self.stroke.pose(self._running_phase(time_s))
             moving = self.stroke.glide_moving
             pose = np.where(moving, running, pose)
             rate = np.where(moving, running_rate, 0.0)
@@ -149,15 +150,14 @@ class LayeredController:
         fading as the target moves abeam or the yaw weight grows. While turning, the per-cycle
         layer's left-right asymmetry is what is wanted, and rules that maximise both hands'
         thrust would even it out."""
-        forward = quat_rotate(state.quat_xyzw[0], FORWARD_LOCAL[self.stroke.start.posture])
+        forward = forward_axis(state.quat_xyzw[0], self.stroke.start.posture)
         turning = max(self.choice.weights.get("yaw_left", 0.0), self.choice.weights.get("yaw_right", 0.0))
         return max(0.0, float(forward @ desired)) ** 2 * max(0.0, 1.0 - turning) ** 3 * self.choice.thrust_demand
 
     def _track_roll(self, state: BodyState) -> None:
         """Accumulate the cycle's mean shoulder roll: a crawl rolls +-30 deg within a cycle, so
         steering reads the cycle average, not a sample."""
-        lateral_z = float(quat_rotate(np.asarray(state.quat_xyzw[2], float), LATERAL_LOCAL)[2])
-        self._roll_sum += math.asin(max(-1.0, min(1.0, lateral_z)))
+        self._roll_sum += shoulder_roll(state.quat_xyzw[2])
         self._roll_n += 1
 
 

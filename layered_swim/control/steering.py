@@ -29,11 +29,19 @@ class Attitude:
     roll_rad: float
 
 
+def forward_axis(pelvis_quat: np.ndarray, posture: str) -> np.ndarray:
+    return quat_rotate(np.asarray(pelvis_quat, float), FORWARD_LOCAL[posture])
+
+
+def shoulder_roll(thorax_quat: np.ndarray) -> float:
+    lateral_z = float(quat_rotate(np.asarray(thorax_quat, float), LATERAL_LOCAL)[2])
+    return math.asin(max(-1.0, min(1.0, lateral_z)))
+
+
 def attitude(pelvis_quat: np.ndarray, thorax_quat: np.ndarray, posture: str) -> Attitude:
-    forward = quat_rotate(np.asarray(pelvis_quat, float), FORWARD_LOCAL[posture])
-    lateral = quat_rotate(np.asarray(thorax_quat, float), LATERAL_LOCAL)
+    forward = forward_axis(pelvis_quat, posture)
     return Attitude(math.atan2(forward[1], forward[0]), math.asin(max(-1.0, min(1.0, forward[2]))),
-                    math.asin(max(-1.0, min(1.0, lateral[2]))))
+                    shoulder_roll(thorax_quat))
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ from scipy.interpolate import PchipInterpolator
 
 from layered_swim.config import ConfigError, Strict, available_files, file_path, load
 from layered_swim.control.pose import JointLayout
+from layered_swim.control.steering import SteeringGains
 
 STROKES_DIR = Path(__file__).resolve().parents[2] / "strokes"
 TABLE_SAMPLES = 1024
@@ -75,9 +76,9 @@ class SteeringSpec(Strict):
     cycle when closer than ``glide_within_m``, with ``glide_moving_joints`` still stroking
     (a crawl's legs keep kicking in a glide, or they sink)."""
 
-    yaw_fraction: float = Field(0.7, ge=0.0, le=1.0)
-    pitch_fraction: float = Field(0.5, ge=0.0, le=1.0)
-    roll_fraction: float = Field(0.5, ge=0.0, le=1.0)
+    yaw_fraction: float = Field(SteeringGains.yaw_fraction, ge=0.0, le=1.0)
+    pitch_fraction: float = Field(SteeringGains.pitch_fraction, ge=0.0, le=1.0)
+    roll_fraction: float = Field(SteeringGains.roll_fraction, ge=0.0, le=1.0)
     min_tempo: float = Field(0.5, ge=0.1, le=1.0)
     glide_within_m: float = Field(0.0, ge=0.0, le=10.0)
     glide_moving_joints: list[str] = []

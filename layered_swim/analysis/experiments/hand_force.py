@@ -10,8 +10,7 @@ import numpy as np
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
 from layered_swim.analysis.files import write_csv
-from layered_swim.runs import build_swim
-from layered_swim.sim.recorder import Recorder
+from layered_swim.runs import build_swim, record
 
 NAME = "hand-force"
 TITLE = "External force on the left hand over one breaststroke cycle from rest (Yang et al. 2004, Fig. 7)"
@@ -32,12 +31,7 @@ def run(config: dict) -> dict:
     setup = build_swim(config["stroke"])
     sim, start = setup.sim, setup.stroke.start
     sim.reset(start.posture, start.depth_m, 0.0)          # from rest
-    recorder = Recorder(sim, sim.config.physics_hz)       # every physics step
-    try:
-        sim.run(config["cycles"] * setup.stroke.period_s, every_step=recorder)
-    finally:
-        sim.close()
-    a = recorder.arrays()
+    a = record(sim, config["cycles"] * setup.stroke.period_s, sim.config.physics_hz).arrays()   # every physics step
     k = sim.body.index(config["segment"])
     return {"time_s": a["time_s"][1:].tolist(), "force_n": a["fluid_force_n"][1:, k].tolist(),
             "buoyancy_n": a["buoyancy_force_n"][1:, k].tolist(), "period_s": setup.stroke.period_s,

@@ -10,8 +10,7 @@ from layered_swim.analysis.experiments.runner import Outcome
 from layered_swim.analysis.files import write_csv
 from layered_swim.control.layered import Layers
 from layered_swim.control.targets import FixedTarget
-from layered_swim.runs import build_swim
-from layered_swim.sim.recorder import Recorder
+from layered_swim.runs import build_swim, record
 
 NAME = "palm-rule"
 TITLE = "Forward displacement of the pelvis with and without the palm rule (Yang et al. 2004, Fig. 13)"
@@ -33,12 +32,7 @@ def run(config: dict) -> dict:
     setup = build_swim(config["stroke"], target=FixedTarget((TARGET_AHEAD_M, 0.0, 0.0)),
                        layers=Layers(cycle=False, palm=config["palm"], reach=False))
     sim = setup.sim
-    recorder = Recorder(sim, LOG_HZ)
-    try:
-        sim.run(config["seconds"], every_step=recorder)
-    finally:
-        sim.close()
-    a = recorder.arrays()
+    a = record(sim, config["seconds"], LOG_HZ).arrays()
     return {"time_s": a["time_s"].tolist(), "forward_m": (a["root_pos_m"][:, 0] - a["root_pos_m"][0, 0]).tolist()}
 
 

@@ -12,8 +12,7 @@ from layered_swim.analysis.files import write_csv
 from layered_swim.analysis.stroke_metrics import heading_deg
 from layered_swim.control.layered import Layers, fixed_weights
 from layered_swim.control.steering import FORWARD_LOCAL
-from layered_swim.runs import build_swim
-from layered_swim.sim.recorder import Recorder
+from layered_swim.runs import build_swim, record
 
 NAME = "turn"
 TITLE = "Yaw over time while treading water with the yaw-left perturbation (Yang et al. 2004, Fig. 11)"
@@ -36,12 +35,7 @@ def run(config: dict) -> dict:
     setup = build_swim(config["stroke"], policy=fixed_weights({config["sequence"]: config["weight"]}, config["basic_cycles"]),
                        layers=Layers(cycle=True, palm=False, reach=False))
     sim, period_s = setup.sim, setup.stroke.period_s
-    recorder = Recorder(sim, LOG_HZ)
-    try:
-        sim.run((config["basic_cycles"] + config["perturbed_cycles"]) * period_s, every_step=recorder)
-    finally:
-        sim.close()
-    a = recorder.arrays()
+    a = record(sim, (config["basic_cycles"] + config["perturbed_cycles"]) * period_s, LOG_HZ).arrays()
     yaw = heading_deg(a["root_quat_xyzw"], FORWARD_LOCAL[setup.stroke.start.posture])
     return {"time_s": a["time_s"].tolist(), "yaw_deg": (yaw - yaw[0]).tolist(), "period_s": period_s}
 
