@@ -2,8 +2,8 @@
 
 Link frames sit at their joint with axes parallel to the zero ("standing") pose; each box and
 its inertia sit at the segment's ``center_m``. Two-axis joints (wrists, ankles) become two
-revolute joints through a small gimbal link. No collision shapes: the swimmer is in open water
-and self-contacts are not modelled.
+revolute joints through a small gimbal link. Each link has a collision shape (see ``_link``), but
+the swimmer is in open water and no contact, self-contact included, is modelled.
 """
 from __future__ import annotations
 
@@ -28,8 +28,8 @@ def _link(name: str, mass: float, inertia, center, geometry: str) -> str:
     ixx, iyy, izz = inertia
     xyz = _vec(center)
     shape = f'<origin xyz="{xyz}"/><geometry>{geometry}</geometry>'
-    # PyBullet's STABLE_PD_CONTROL returns NaN for links without a collision shape, so every
-    # link gets one; the world switches their collision filtering off.
+    # PyBullet's STABLE_PD_CONTROL, which the tests check our stable PD against, returns NaN for
+    # links without a collision shape, so every link gets one; the world filters out all contacts.
     return (f"<link name={quoteattr(name)}><inertial><origin xyz=\"{xyz}\"/><mass value=\"{mass:.6g}\"/>"
             f'<inertia ixx="{ixx:.6g}" iyy="{iyy:.6g}" izz="{izz:.6g}" ixy="0" ixz="0" iyz="0"/>'
             f"</inertial><visual>{shape}</visual><collision>{shape}</collision></link>")

@@ -67,7 +67,6 @@ class Recorder:
         self._rows: dict[str, list] = {name: [] for name in ARRAY_NAMES if name != "head_top_m"}
         self._work_j = None
         if joint_work:
-            sim.world.enable_joint_torque_sensors()
             self._dt_s = 1.0 / physics_hz
             self._work_j, self._rates = 0.0, sim.world.joint_torques_and_rates()[1]
             self._rows["joint_work_j"] = []

@@ -2,7 +2,13 @@
 
 A World owns the swimmer's multibody. Each physics step the simulation loop reads a
 ``BodyState`` (per-segment centre-of-mass pose and velocity), applies one external force and
-torque per segment, sets the stable-PD targets and steps.
+torque per segment, drives the joints with stable PD and steps.
+
+The state is read as joint positions and rates (one batched call) and turned into segment poses
+by our own compiled forward kinematics, which also gives the mass matrix that stable PD needs.
+PyBullet's STABLE_PD_CONTROL builds a second model of the body and solves it on every call, more
+than a third of the whole step; ``layered_swim.control.pd`` computes the same torques (tested
+against it) and PyBullet only applies them.
 
 The per-step calls go to the ``pybullet`` functions with the World's own client id rather than
 through ``BulletClient``: its attribute lookup builds a new partial per call, which cost about as
@@ -23,7 +29,11 @@ import numpy as np
 
 from layered_swim.body.model import Body
 from layered_swim.body.urdf import write_urdf
+from layered_swim.control.pd import stable_pd_torques
 from layered_swim.control.pose import JointLayout
+from layered_swim.sim.articulation import (ANGVEL, FRAME_COLUMNS, FREE, LINVEL, POS, QUAT, REVOLUTE, SPHERICAL,
+                                           Tree, forward_kinematics, generalized_forces,
+                                           mass_matrix_and_bias)
 
 
 @contextlib.contextmanager
@@ -49,8 +59,8 @@ with _pybullet_quiet():
     from pybullet_utils.bullet_client import BulletClient
 
 
-# getLinkStates' fields: centre-of-mass position and orientation, world velocity and spin.
-_COM_STATE = operator.itemgetter(0, 1, 6, 7)
+# getJointStatesMultiDof's fields: position, rate.
+_JOINT_POSITION, _JOINT_RATE = operator.itemgetter(0), operator.itemgetter(1)
 _flatten = chain.from_iterable
 
 
@@ -63,6 +73,28 @@ class BodyState:
     quat_xyzw: np.ndarray      # (n, 4)
     linvel_m_s: np.ndarray     # (n, 3)
     angvel_rad_s: np.ndarray   # (n, 3)
+
+
+def _tree(client, uid: int) -> Tree:
+    """PyBullet's own view of the loaded body: joint frames, axes, masses and inertias."""
+    parent, kind, pivot, com, axis = [-1], [FREE], [(0.0, 0.0, 0.0)], [(0.0, 0.0, 0.0)], [(0.0, 0.0, 0.0)]
+    base = client.getDynamicsInfo(uid, -1)
+    mass, inertia, frames = [base[0]], [base[2]], [base[4]]
+    for j in range(client.getNumJoints(uid)):
+        info, dynamics = client.getJointInfo(uid, j), client.getDynamicsInfo(uid, j)
+        parent.append(info[16] + 1)
+        kind.append(SPHERICAL if info[2] == pybullet.JOINT_SPHERICAL else REVOLUTE)
+        pivot.append(info[14])
+        axis.append(info[13])
+        com.append(dynamics[3])
+        mass.append(dynamics[0])
+        inertia.append(dynamics[2])
+        frames += [info[15], dynamics[4]]
+    # The URDF never turns a joint or inertial frame (see body/urdf.py); the kinematics relies on it.
+    if not np.allclose(frames, (0.0, 0.0, 0.0, 1.0)):
+        raise ValueError("the body's URDF turns a joint or inertial frame; forward kinematics assumes it does not")
+    return Tree(np.array(parent), np.array(kind), np.array(pivot, dtype=float), np.array(com, dtype=float),
+                np.array(axis, dtype=float), np.array(mass, dtype=float), np.array(inertia, dtype=float))
 
 
 class World:
@@ -82,36 +114,58 @@ class World:
                 self.uid = self.client.loadURDF(str(urdf), flags=pybullet.URDF_USE_INERTIA_FROM_FILE)
         self._cid = self.client._client
         c = self.client
-        names = {c.getJointInfo(self.uid, j)[12].decode(): j for j in range(c.getNumJoints(self.uid))}
-        joint_index = {c.getJointInfo(self.uid, j)[1].decode(): j for j in range(c.getNumJoints(self.uid))}
+        n_joints = c.getNumJoints(self.uid)
+        names = {c.getJointInfo(self.uid, j)[12].decode(): j for j in range(n_joints)}
+        joint_index = {c.getJointInfo(self.uid, j)[1].decode(): j for j in range(n_joints)}
         self.segment_links = [-1] + [names[s] for s in body.segment_names[1:]]
-        self._child_links = self.segment_links[1:]
-        self._state_size = 13 * len(self.segment_links)
-        for link in [-1, *range(c.getNumJoints(self.uid))]:
-            # Open water: no contacts at all (collision shapes exist only for stable PD's sake).
-            c.setCollisionFilterGroupMask(self.uid, link, 0, 0)
-        for j in range(c.getNumJoints(self.uid)):
+        for link in [-1, *range(n_joints)]:
+            c.setCollisionFilterGroupMask(self.uid, link, 0, 0)   # open water: no contacts at all
+        # PyBullet's default joint motors would fight the PD torques: switch them off.
+        for j in range(n_joints):
             if c.getJointInfo(self.uid, j)[2] == pybullet.JOINT_SPHERICAL:
                 c.setJointMotorControlMultiDof(self.uid, j, pybullet.POSITION_CONTROL, targetPosition=[0, 0, 0, 1],
                                                targetVelocity=[0, 0, 0], force=[0, 0, 0])
             else:
                 c.setJointMotorControl2(self.uid, j, pybullet.VELOCITY_CONTROL, force=0)
 
-        self.motor_indices = [joint_index[name] for name in layout.motor_joint]
+        self.tree = _tree(c, self.uid)
+        tree = self.tree
+        self._joints = list(range(n_joints))   # tree body j + 1 hangs from joint j
+        self._segment_rows = np.array(self.segment_links) + 1
+        self._frames = np.zeros((tree.n_bodies, FRAME_COLUMNS))
+        self._state_size = tree.n_positions + tree.n_dof
+        self._fresh = False
+        # Where each joint's positions and rates sit in the generalised vectors, and per motor
+        # where its targets sit in the flat lists ``set_targets`` builds (ball joints first, then
+        # every pose angle: see JointLayout).
+        joint_q = [range(tree.index[j + 1, 2], tree.index[j + 1, 2] + (4 if k == SPHERICAL else 1))
+                   for j, k in enumerate(tree.kind[1:])]
+        joint_qd = [range(tree.index[j + 1, 3], tree.index[j + 1, 3] + (3 if k == SPHERICAL else 1))
+                    for j, k in enumerate(tree.kind[1:])]
+        self._torque_cuts = [(r.start, r.stop) for r in joint_qd]
+        n_ball = len(layout.ball_slices)
         scale = pd_gain_scale or {}
-        kp, kd, force = [], [], []
-        for motor_name, is_ball in zip(layout.motor_joint, layout.motor_is_ball):
+        gains = np.zeros((3, tree.n_dof))
+        q_at, q_from, qd_at, qd_from = [], [], [], []
+        self.motor_indices = [joint_index[name] for name in layout.motor_joint]
+        for m, (motor_name, index) in enumerate(zip(layout.motor_joint, self.motor_indices)):
             joint = next(j for j in body.joints if motor_name == j.name or motor_name.startswith(j.name + "_"))
             s = scale.get(joint.name, 1.0)
-            kp.append(joint.kp * s)
-            kd.append(joint.kd * s)
-            force.append([joint.max_torque_nm] * (3 if is_ball else 1))
-        self._kp, self._kd, self._force = kp, kd, force
-        n_ball = len(layout.ball_slices)
-        self._position_cuts = [(4 * b, 4 * b + 4) if b >= 0 else (4 * n_ball + k, 4 * n_ball + k + 1)
-                               for b, k in zip(layout.motor_ball, layout.motor_coord)]
-        self._velocity_cuts = [(3 * b, 3 * b + 3) if b >= 0 else (3 * n_ball + k, 3 * n_ball + k + 1)
-                               for b, k in zip(layout.motor_ball, layout.motor_coord)]
+            b, k = layout.motor_ball[m], layout.motor_coord[m]
+            q_at += joint_q[index]
+            q_from += range(4 * b, 4 * b + 4) if b >= 0 else [4 * n_ball + k]
+            qd_at += joint_qd[index]
+            qd_from += range(3 * b, 3 * b + 3) if b >= 0 else [3 * n_ball + k]
+            gains[:, joint_qd[index]] = np.array([[joint.kp * s], [joint.kd * s], [joint.max_torque_nm]])
+        self._gains = gains
+        self._q_at, self._q_from = np.array(q_at), np.array(q_from)
+        self._qd_at, self._qd_from = np.array(qd_at), np.array(qd_from)
+        self._target_q = np.zeros(tree.n_positions)
+        self._target_qd = np.zeros(tree.n_dof)
+        self._torque = np.zeros(tree.n_dof)
+        self._no_load = np.zeros(tree.n_dof)
+        self._load = self._no_load    # joint part of the last applied wrenches, until the step
+        self._sent = True
 
     # --- state -------------------------------------------------------------------------
     def reset(self, root_pos_m, root_quat_xyzw, pose: np.ndarray, root_linvel_m_s=(0.0, 0.0, 0.0)) -> None:
@@ -125,88 +179,100 @@ class World:
             else:
                 c.resetJointState(self.uid, joint, float(pose[self.layout.motor_coord[m]]), 0.0)
         self.steps = 0
+        self._torque[:] = 0.0
+        self._load, self._sent = self._no_load, True
+        self._fresh = False
 
     @property
     def time_s(self) -> float:
         return self.steps * self.dt_s  # a product, not a running sum: no drift over long runs
 
     def read_state(self) -> BodyState:
-        uid, cid = self.uid, self._cid
+        uid, cid, tree = self.uid, self._cid, self.tree
         base_pos, base_quat = pybullet.getBasePositionAndOrientation(uid, cid)
         base_lin, base_ang = pybullet.getBaseVelocity(uid, cid)
-        # With velocities, and the kinematics recomputed: the cached link frames are stale after a step.
-        links = pybullet.getLinkStates(uid, self._child_links, 1, 1, cid)
-        # One flat pass into one array: per segment position, quaternion, velocity, spin.
-        flat = chain(base_pos, base_quat, base_lin, base_ang, _flatten(_flatten(map(_COM_STATE, links))))
-        table = np.fromiter(flat, np.float64, self._state_size).reshape(-1, 13)
-        return BodyState(self.time_s, table[:, 0:3], table[:, 3:7], table[:, 7:10], table[:, 10:13])
+        joints = pybullet.getJointStatesMultiDof(uid, self._joints, cid)
+        # One flat pass into the generalised positions, then rates (see articulation.Tree).
+        flat = np.fromiter(chain(base_pos, base_quat, _flatten(map(_JOINT_POSITION, joints)), base_ang, base_lin,
+                                 _flatten(map(_JOINT_RATE, joints))), np.float64, self._state_size)
+        self._q, self._qd = flat[:tree.n_positions], flat[tree.n_positions:]
+        forward_kinematics(tree.index, tree.params, self._q, self._qd, self._frames)
+        self._fresh = True
+        segments = self._frames[self._segment_rows]
+        return BodyState(self.time_s, segments[:, POS], segments[:, QUAT], segments[:, LINVEL], segments[:, ANGVEL])
+
+    def _ensure_fresh(self) -> None:
+        if not self._fresh:
+            self.read_state()
+
+    def kinematics(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The generalised positions and rates now (see ``articulation.Tree``) and every body's
+        frame (``articulation.FRAME_COLUMNS``); views, valid until the next step."""
+        self._ensure_fresh()
+        return self._q, self._qd, self._frames
 
     def joint_positions(self) -> np.ndarray:
         """Current pose as PyBullet reports it: ball joints as quaternions, hinges as angles,
         flattened motor by motor."""
-        states = self.client.getJointStatesMultiDof(self.uid, self.motor_indices)
-        return np.concatenate([s[0] for s in states])
-
-    def enable_joint_torque_sensors(self) -> None:
-        """Have every step compute the wrench each motor joint transmits (``joint_torques_and_rates``).
-        Off by default: it costs a few per cent of the step."""
-        c = self.client
-        for joint in self.motor_indices:
-            c.enableJointForceTorqueSensor(self.uid, joint, True)
-        # The transmitted wrench comes about the child's centre of mass; the joint pivot is the
-        # child link's origin. A hinge's torque is the wrench's part along its axis.
-        com_m = np.array([c.getDynamicsInfo(self.uid, j)[3] for j in self.motor_indices])
-        rows = []
-        for m, (joint, is_ball) in enumerate(zip(self.motor_indices, self.layout.motor_is_ball)):
-            axes = np.eye(3) if is_ball else np.array([c.getJointInfo(self.uid, joint)[13]])
-            for axis in axes:
-                row = np.zeros((len(self.motor_indices), 3))
-                row[m] = axis
-                rows.append(row.ravel())
-        self._torque_com_m, self._torque_rows = com_m, np.array(rows)
+        self._ensure_fresh()
+        return self._q[self._q_at]
 
     def joint_torques_and_rates(self) -> tuple[np.ndarray, np.ndarray]:
         """Torque each motor applied during the last step (N m) and the joint rates now (rad/s),
         flattened motor by motor as in ``joint_positions``: a ball joint's three components in the
-        child frame, one value per hinge; their dot product is the joints' mechanical power.
-        PyBullet reports no applied torque under STABLE_PD_CONTROL, so the torque is read from the
-        joint's transmitted wrench (``enable_joint_torque_sensors`` first): a ball joint passes no
-        torque but the motor's, and a hinge none about its axis but the motor's."""
-        states = self.client.getJointStatesMultiDof(self.uid, self.motor_indices)
-        wrench = np.array([s[2] for s in states])
-        about_pivot = wrench[:, 3:] + np.cross(self._torque_com_m, wrench[:, :3])
-        return self._torque_rows @ about_pivot.ravel(), np.concatenate([s[1] for s in states])
+        child frame, one value per hinge; their dot product is the joints' mechanical power."""
+        self._ensure_fresh()
+        return self._torque[self._qd_at], self._qd[self._qd_at]
 
     # --- actions -----------------------------------------------------------------------
     def apply_wrenches(self, force_n: np.ndarray, torque_nm: np.ndarray, at_m: np.ndarray) -> None:
-        """One force (at each segment's centre of mass ``at_m``) and one torque per segment, world frame."""
+        """One force (at ``at_m``, each segment's centre of mass) and one torque per segment, world
+        frame, for the next step. They go in as the generalised forces they make: the base's as a
+        base wrench, the joints' added to the motor torques. (PyBullet's per-link external force
+        would take its lever arm from link frames it updates only when asked, at a cost.)"""
+        self._ensure_fresh()
+        tree = self.tree
+        load = generalized_forces(tree.index, tree.params, self._frames, tree.n_dof, self._segment_rows, force_n,
+                                  torque_nm, at_m)
         uid, cid, frame = self.uid, self._cid, pybullet.WORLD_FRAME
-        force, torque = pybullet.applyExternalForce, pybullet.applyExternalTorque
-        # Positional arguments: PyBullet parses a keyword argument at a third of the call's cost.
-        for link, f, t, p in zip(self.segment_links, force_n.tolist(), torque_nm.tolist(), at_m.tolist()):
-            force(uid, link, f, p, frame, cid)
-            torque(uid, link, t, frame, cid)
+        pybullet.applyExternalForce(uid, -1, load[3:6].tolist(), self._q[0:3].tolist(), frame, cid)
+        pybullet.applyExternalTorque(uid, -1, load[0:3].tolist(), frame, cid)
+        load[0:6] = 0.0
+        self._load = load
+        self._sent = False
 
     def set_targets(self, pose: np.ndarray, rates: np.ndarray) -> None:
-        """Convert a desired pose and its rates into PyBullet's per-motor targets (at control rate)."""
+        """Convert a desired pose and its rates into the joints' targets (at control rate)."""
         quats, omegas = self.layout.ball_targets(pose, rates)
-        # One list per kind, cut motor by motor (ball joints first in it, then every pose angle).
-        positions = quats.ravel().tolist() + pose.tolist()
-        velocities = omegas.ravel().tolist() + rates.tolist()
-        self._targets = [positions[a:b] for a, b in self._position_cuts]
-        self._velocities = [velocities[a:b] for a, b in self._velocity_cuts]
+        self._target_q[self._q_at] = np.concatenate([quats.ravel(), pose])[self._q_from]
+        self._target_qd[self._qd_at] = np.concatenate([omegas.ravel(), rates])[self._qd_from]
 
     def drive(self) -> None:
-        """Stable PD toward the last targets. PyBullet computes the torque once per call and holds
-        it, so this must be called before every physics step."""
-        pybullet.setJointMotorControlMultiDofArray(
-            self.uid, self.motor_indices, pybullet.STABLE_PD_CONTROL, targetPositions=self._targets,
-            targetVelocities=self._velocities, positionGains=self._kp, velocityGains=self._kd, forces=self._force,
-            physicsClientId=self._cid)
+        """Stable PD toward the last targets from the current state: the torques hold for the
+        next step only, so this must be called before every physics step."""
+        self._ensure_fresh()
+        tree = self.tree
+        mass, bias = mass_matrix_and_bias(tree.index, tree.params, self._frames, tree.n_dof, self.gravity_m_s2)
+        self._torque = stable_pd_torques(mass, bias, tree.index, self._q, self._qd, self._target_q, self._target_qd,
+                                         self._gains, self.dt_s)
+        self._send(self._torque + self._load)
+
+    def _send(self, torque: np.ndarray) -> None:
+        """Joint torques for the next step (PyBullet adds up what it is sent and clears it after the step)."""
+        flat = torque.tolist()
+        pybullet.setJointMotorControlMultiDofArray(self.uid, self._joints, pybullet.TORQUE_CONTROL,
+                                                   forces=[flat[a:b] for a, b in self._torque_cuts],
+                                                   physicsClientId=self._cid)
+        self._sent = True
 
     def step(self) -> None:
+        if not self._sent:
+            self._send(self._load)  # wrenches applied with no drive() this step
         pybullet.stepSimulation(physicsClientId=self._cid)
         self.steps += 1
+        self._fresh = False
+        self._load = self._no_load
+        self._sent = True
 
     def close(self) -> None:
         with contextlib.suppress(Exception):
