@@ -1,5 +1,5 @@
-"""The joints' mechanical work, read from the joints' transmitted wrenches, closes the energy
-balance of a swim: joint work = change of kinetic and potential energy - work of the water."""
+"""The joints' mechanical work, from the torques stable PD applied, closes the energy balance of
+a swim: joint work = change of kinetic and potential energy - work of the water."""
 import numpy as np
 import pytest
 

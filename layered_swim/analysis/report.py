@@ -41,9 +41,8 @@ DEFINITIONS = """\
   along the thrust axis. **Active drag** is the mean resistive force at the swimming speed (in
   steady swimming it equals the mean propulsive force). Counting per segment, limbs recovering
   against the water count as drag, so this is larger than a whole-body measurement would be.
-- **Mechanical power**: the joint torques (read from the joints' transmitted wrenches, which
-  close the energy balance of each step) times the joint rates, summed over joints and averaged
-  over the cycle. **Propelling efficiency** = active drag x mean speed / mechanical power.
+- **Mechanical power**: the stable-PD torques the joints applied (they close the energy balance
+  of a swim) times the joint rates, summed over joints and averaged over the cycle. **Propelling efficiency** = active drag x mean speed / mechanical power.
 """
 
 

@@ -238,7 +238,7 @@ class World:
         pybullet.applyExternalForce(uid, -1, load[3:6].tolist(), self._q[0:3].tolist(), frame, cid)
         pybullet.applyExternalTorque(uid, -1, load[0:3].tolist(), frame, cid)
         load[0:6] = 0.0
-        self._load = load
+        self._load = load if self._sent else self._load + load   # PyBullet adds up repeated pushes too
         self._sent = False
 
     def set_targets(self, pose: np.ndarray, rates: np.ndarray) -> None:
