@@ -8,7 +8,6 @@ from layered_swim.body.model import load_body
 from layered_swim.control.pd import _ball_error
 from layered_swim.control.pose import joint_layout, quat_multiply
 from layered_swim.runs import build_swim
-from layered_swim.sim.articulation import SPHERICAL
 from layered_swim.sim.simulation import UPRIGHT_QUAT_XYZW
 from layered_swim.sim.world import World
 
@@ -78,13 +77,12 @@ def test_stable_pd_matches_pybullets():
         target_q, target_qd, gains = world._target_q, world._target_qd, world._gains
         positions, rates, kp, kd, limit = [], [], [], [], []
         for j in world._joints:
-            qa, da = tree.index[j + 1, 2], tree.index[j + 1, 3]
-            size = 3 if tree.kind[j + 1] == SPHERICAL else 1
-            positions.append(target_q[qa:qa + (4 if size == 3 else 1)].tolist())
-            rates.append(target_qd[da:da + size].tolist())
-            kp.append(gains[0, da])
-            kd.append(gains[1, da])
-            limit.append(gains[2, da:da + size].tolist())
+            at, rate = tree.positions_of(j + 1), tree.rates_of(j + 1)
+            positions.append(target_q[at].tolist())
+            rates.append(target_qd[rate].tolist())
+            kp.append(gains[0, rate.start])
+            kd.append(gains[1, rate.start])
+            limit.append(gains[2, rate].tolist())
         saved = world.client.saveState()
         world.drive()
         world.step()

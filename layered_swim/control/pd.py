@@ -1,6 +1,6 @@
 """Stable PD (Tan, Liu and Turk 2011), as PyBullet's STABLE_PD_CONTROL computes it.
 
-The torque drives each joint toward where its target will be one step ahead, with the damping
+The torque drives each joint to its target from where the joint will be one step ahead, with the damping
 made implicit through the body's mass matrix:
 
     tau = Kp e + Kd (qd_target - qd - dt qdd),   e = target - (q + dt qd),

@@ -22,16 +22,15 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from layered_swim.control.pose import _quat_mul
+
 FREE, SPHERICAL, REVOLUTE = 0, 1, 2
 
-# Columns of the per-body kinematics table ``frames``.
-POS, QUAT, LINVEL, ANGVEL, ROT, JOINT_AT = slice(0, 3), slice(3, 7), slice(7, 10), slice(10, 13), slice(13, 22), \
-    slice(22, 25)
+# Columns of the per-body kinematics table ``frames`` (then the joint pivot, 22:25).
+POS, QUAT, LINVEL, ANGVEL, ROT = slice(0, 3), slice(3, 7), slice(7, 10), slice(10, 13), slice(13, 22)
 FRAME_COLUMNS = 25
 
-
-def _rates(kind: int) -> int:
-    return 6 if kind == FREE else (3 if kind == SPHERICAL else 1)
+_SIZES = {FREE: (7, 6), SPHERICAL: (4, 3), REVOLUTE: (1, 1)}   # positions, rates
 
 
 @dataclass(frozen=True)
@@ -49,13 +48,12 @@ class Tree:
     inertia_kg_m2: np.ndarray    # (n, 3) principal moments about the centre of mass
 
     def __post_init__(self):
-        sizes = {FREE: (7, 6), SPHERICAL: (4, 3), REVOLUTE: (1, 1)}
         q_at, dof_at, q, dof = [], [], 0, 0
         for kind in self.kind:
             q_at.append(q)
             dof_at.append(dof)
-            q += sizes[int(kind)][0]
-            dof += sizes[int(kind)][1]
+            q += _SIZES[int(kind)][0]
+            dof += _SIZES[int(kind)][1]
         object.__setattr__(self, "_index", np.column_stack([self.parent, self.kind, q_at, dof_at]).astype(np.int64))
         object.__setattr__(self, "_params", np.ascontiguousarray(np.column_stack(
             [self.joint_in_parent_m, self.com_in_joint_m, self.axis, self.mass_kg, self.inertia_kg_m2]),
@@ -67,11 +65,20 @@ class Tree:
 
     @property
     def n_positions(self) -> int:
-        return int(self._index[-1, 2] + (4 if self.kind[-1] == SPHERICAL else 1))
+        return self.positions_of(self.n_bodies - 1).stop
 
     @property
     def n_dof(self) -> int:
-        return int(self._index[-1, 3] + _rates(self.kind[-1]))
+        return self.rates_of(self.n_bodies - 1).stop
+
+    def positions_of(self, body: int) -> range:
+        """Where body ``body``'s joint positions sit in the generalised positions."""
+        start = int(self._index[body, 2])
+        return range(start, start + _SIZES[int(self.kind[body])][0])
+
+    def rates_of(self, body: int) -> range:
+        start = int(self._index[body, 3])
+        return range(start, start + _SIZES[int(self.kind[body])][1])
 
     @property
     def index(self) -> np.ndarray:
@@ -82,14 +89,6 @@ class Tree:
     def params(self) -> np.ndarray:
         """(n, 13): pivot in parent, centre of mass in joint frame, axis, mass, inertia (packed)."""
         return self._params
-
-
-@njit(cache=True, inline="always")
-def _quat_mul(a, b, out):
-    out[0] = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1]
-    out[1] = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0]
-    out[2] = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3]
-    out[3] = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2]
 
 
 @njit(cache=True, inline="always")

@@ -138,10 +138,8 @@ class World:
         # Where each joint's positions and rates sit in the generalised vectors, and per motor
         # where its targets sit in the flat lists ``set_targets`` builds (ball joints first, then
         # every pose angle: see JointLayout).
-        joint_q = [range(tree.index[j + 1, 2], tree.index[j + 1, 2] + (4 if k == SPHERICAL else 1))
-                   for j, k in enumerate(tree.kind[1:])]
-        joint_qd = [range(tree.index[j + 1, 3], tree.index[j + 1, 3] + (3 if k == SPHERICAL else 1))
-                    for j, k in enumerate(tree.kind[1:])]
+        joint_q = [tree.positions_of(j + 1) for j in self._joints]
+        joint_qd = [tree.rates_of(j + 1) for j in self._joints]
         self._torque_cuts = [(r.start, r.stop) for r in joint_qd]
         n_ball = len(layout.ball_slices)
         scale = pd_gain_scale or {}
