@@ -21,7 +21,7 @@ def swimming():
 
 def test_forward_kinematics_matches_pybullet(swimming):
     world = swimming.world
-    _, _, frames = world.kinematics()
+    _, _, frames, _ = world.kinematics()
     links = pybullet.getLinkStates(world.uid, world._joints, 1, 1, physicsClientId=world._cid)
     theirs = frames[1:]
     np.testing.assert_allclose(theirs[:, POS], [s[0] for s in links], atol=1e-12)
@@ -39,8 +39,8 @@ def test_mass_matrix_gives_the_kinetic_energy(swimming):
     """1/2 qd.M.qd equals the bodies' kinetic energy summed box by box."""
     world = swimming.world
     tree = world.tree
-    _, qd, frames = world.kinematics()
-    mass, _ = mass_matrix_and_bias(tree.index, tree.params, frames, tree.n_dof, GRAVITY_M_S2)
+    _, qd, frames, subspace = world.kinematics()
+    mass, _ = mass_matrix_and_bias(tree.index, tree.params, frames, subspace, GRAVITY_M_S2)
     assert np.allclose(mass, mass.T, atol=1e-12)
     assert np.linalg.eigvalsh(mass).min() > 0.0
     np.testing.assert_allclose(mass[3:6, 3:6], np.eye(3) * tree.mass_kg.sum(), rtol=1e-12)
@@ -58,16 +58,15 @@ def test_bias_at_rest_is_the_weight(swimming):
     bodies' weights, and on the base it is the whole weight, upwards."""
     world = swimming.world
     tree = world.tree
-    _, _, frames = world.kinematics()
+    _, _, frames, subspace = world.kinematics()
     still = frames.copy()
     still[:, LINVEL] = 0.0
     still[:, ANGVEL] = 0.0
-    _, bias = mass_matrix_and_bias(tree.index, tree.params, still, tree.n_dof, GRAVITY_M_S2)
+    _, bias = mass_matrix_and_bias(tree.index, tree.params, still, subspace, GRAVITY_M_S2)
     rows = np.arange(tree.n_bodies)
     weight = np.zeros((tree.n_bodies, 3))
     weight[:, 2] = -GRAVITY_M_S2 * tree.mass_kg
-    load = generalized_forces(tree.index, tree.params, still, tree.n_dof, rows, weight, np.zeros_like(weight),
-                              still[:, POS])
+    load = generalized_forces(tree.index, still, subspace, rows, weight, np.zeros_like(weight), still[:, POS])
     np.testing.assert_allclose(bias + load, 0.0, atol=1e-9)
     assert bias[5] == pytest.approx(GRAVITY_M_S2 * tree.mass_kg.sum(), rel=1e-12)
 

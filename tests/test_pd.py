@@ -72,8 +72,7 @@ def test_stable_pd_matches_pybullets():
     try:
         sim.run(1.3)
         world, tree = sim.world, sim.world.tree
-        q, qd, _ = world.kinematics()
-        before = qd.copy()
+        before = world.kinematics()[1].copy()
         target_q, target_qd, gains = world._target_q, world._target_qd, world._gains
         positions, rates, kp, kd, limit = [], [], [], [], []
         for j in world._joints:

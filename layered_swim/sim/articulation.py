@@ -33,6 +33,11 @@ FRAME_COLUMNS = 25
 _SIZES = {FREE: (7, 6), SPHERICAL: (4, 3), REVOLUTE: (1, 1)}   # positions, rates
 
 
+@njit(cache=True, inline="always")
+def _rate_count(kind):
+    return 6 if kind == FREE else (3 if kind == SPHERICAL else 1)
+
+
 @dataclass(frozen=True)
 class Tree:
     """Body 0 is the base; body i > 0 hangs from ``parent[i] < i`` by PyBullet joint i - 1.
@@ -107,11 +112,13 @@ def _quat_to_rows(q, out):
 
 
 @njit(cache=True)
-def forward_kinematics(index, params, q, qd, frames):
+def forward_kinematics(index, params, q, qd, frames, subspace):
     """Fill ``frames`` (n, FRAME_COLUMNS): per body its centre of mass, orientation (x, y, z, w),
     velocity, angular velocity, rotation matrix (row-major) and joint pivot, all in world
-    coordinates. ``q``: the base's position and quaternion, then the joints'; ``qd``: the base's
-    angular velocity and velocity, then the joints' rates."""
+    coordinates; and ``subspace`` (n_dof, 6): each rate's unit spatial motion about the base's
+    centre of mass, which the dynamics and the generalised forces share. ``q``: the base's
+    position and quaternion, then the joints'; ``qd``: the base's angular velocity and velocity,
+    then the joints' rates."""
     frames[0, 0:7] = q[0:7]
     frames[0, 7:10] = qd[3:6]
     frames[0, 10:13] = qd[0:3]
@@ -154,6 +161,7 @@ def forward_kinematics(index, params, q, qd, frames):
         frames[i, 7] = frames[p, 7] + wp[1] * ez - wp[2] * ey + wi[1] * dz - wi[2] * dy
         frames[i, 8] = frames[p, 8] + wp[2] * ex - wp[0] * ez + wi[2] * dx - wi[0] * dz
         frames[i, 9] = frames[p, 9] + wp[0] * ey - wp[1] * ex + wi[0] * dy - wi[1] * dx
+    _motion_subspace(index, params, frames, subspace)
 
 
 @njit(cache=True, inline="always")
@@ -189,9 +197,8 @@ def _spatial_inertia(m, c, rows, inertia, out):
 
 
 @njit(cache=True)
-def _motion_subspace(index, params, frames, n_dof):
-    """(n_dof, 6): each rate's unit spatial motion about the base's centre of mass."""
-    s = np.zeros((n_dof, 6))
+def _motion_subspace(index, params, frames, s):
+    s[0:6] = 0.0
     for k in range(6):
         s[k, k] = 1.0  # base: world angular velocity, then centre-of-mass velocity
     pivot = np.empty(3)
@@ -200,7 +207,7 @@ def _motion_subspace(index, params, frames, n_dof):
         r = frames[i, 13:22]
         for a in range(3):
             pivot[a] = frames[i, 22 + a] - frames[0, a]
-        for k in range(3 if kind == SPHERICAL else 1):
+        for k in range(_rate_count(kind)):
             row = s[da + k]
             for a in range(3):
                 if kind == SPHERICAL:
@@ -208,7 +215,6 @@ def _motion_subspace(index, params, frames, n_dof):
                 else:
                     row[a] = r[3 * a] * params[i, 6] + r[3 * a + 1] * params[i, 7] + r[3 * a + 2] * params[i, 8]
             _cross(pivot, row[0:3], row[3:6])
-    return s
 
 
 @njit(cache=True, inline="always")
@@ -243,12 +249,13 @@ def _mat6_vec(m, v, out):
 
 
 @njit(cache=True)
-def mass_matrix_and_bias(index, params, frames, n_dof, gravity_m_s2):
+def mass_matrix_and_bias(index, params, frames, s, gravity_m_s2):
     """Joint-space mass matrix M (n_dof, n_dof) and bias forces C (gravity, centrifugal and
     Coriolis) such that M qdd + C = generalised forces: the composite-rigid-body algorithm and
-    recursive Newton-Euler with qdd = 0, all in one frame so no spatial transforms are needed."""
+    recursive Newton-Euler with qdd = 0, all in one frame so no spatial transforms are needed.
+    ``frames`` and the motion subspace ``s`` as ``forward_kinematics`` fills them."""
     n = index.shape[0]
-    s = _motion_subspace(index, params, frames, n_dof)
+    n_dof = s.shape[0]
     inertia = np.empty((n, 6, 6))
     vel = np.empty((n, 6))
     acc = np.empty((n, 6))
@@ -288,8 +295,7 @@ def mass_matrix_and_bias(index, params, frames, n_dof, gravity_m_s2):
     f = np.empty(6)
     for i in range(n - 1, -1, -1):
         kind, da, p = index[i, 1], index[i, 3], index[i, 0]
-        nd = 6 if kind == FREE else (3 if kind == SPHERICAL else 1)
-        for k in range(nd):
+        for k in range(_rate_count(kind)):
             col = da + k
             t = 0.0
             for a in range(6):
@@ -299,9 +305,8 @@ def mass_matrix_and_bias(index, params, frames, n_dof, gravity_m_s2):
             _mat6_vec(inertia[i], s[col], f)
             j = i
             while j >= 0:
-                kj, dj = index[j, 1], index[j, 3]
-                nj = 6 if kj == FREE else (3 if kj == SPHERICAL else 1)
-                for r in range(dj, dj + nj):
+                dj = index[j, 3]
+                for r in range(dj, dj + _rate_count(index[j, 1])):
                     t = 0.0
                     for a in range(6):
                         t += s[r, a] * f[a]
@@ -317,10 +322,11 @@ def mass_matrix_and_bias(index, params, frames, n_dof, gravity_m_s2):
 
 
 @njit(cache=True)
-def generalized_forces(index, params, frames, n_dof, rows, force, torque, at):
+def generalized_forces(index, frames, s, rows, force, torque, at):
     """The generalised forces (n_dof,) of a force (applied at ``at``) and a torque on each of the
     bodies ``rows`` (world frame): each rate feels the wrench of the whole subtree it carries.
-    The base's six are the total moment about its centre of mass, then the total force."""
+    The base's six are the total moment about its centre of mass, then the total force.
+    ``frames`` and the motion subspace ``s`` as ``forward_kinematics`` fills them."""
     n = index.shape[0]
     wrench = np.zeros((n, 6))
     for r in range(rows.shape[0]):
@@ -333,11 +339,10 @@ def generalized_forces(index, params, frames, n_dof, rows, force, torque, at):
         wrench[i, 3] += fx
         wrench[i, 4] += fy
         wrench[i, 5] += fz
-    s = _motion_subspace(index, params, frames, n_dof)
-    out = np.empty(n_dof)
+    out = np.empty(s.shape[0])
     for i in range(n - 1, -1, -1):
         kind, da, p = index[i, 1], index[i, 3], index[i, 0]
-        for k in range(6 if kind == FREE else (3 if kind == SPHERICAL else 1)):
+        for k in range(_rate_count(kind)):
             t = 0.0
             for a in range(6):
                 t += s[da + k, a] * wrench[i, a]

@@ -133,6 +133,7 @@ class World:
         self._joints = list(range(n_joints))   # tree body j + 1 hangs from joint j
         self._segment_rows = np.array(self.segment_links) + 1
         self._frames = np.zeros((tree.n_bodies, FRAME_COLUMNS))
+        self._subspace = np.zeros((tree.n_dof, 6))
         self._state_size = tree.n_positions + tree.n_dof
         self._fresh = False
         # Where each joint's positions and rates sit in the generalised vectors, and per motor
@@ -161,9 +162,7 @@ class World:
         self._target_q = np.zeros(tree.n_positions)
         self._target_qd = np.zeros(tree.n_dof)
         self._torque = np.zeros(tree.n_dof)
-        self._no_load = np.zeros(tree.n_dof)
-        self._load = self._no_load    # joint part of the last applied wrenches, until the step
-        self._sent = True
+        self._pending: np.ndarray | None = None   # generalised forces for the next step: PD and wrenches
 
     # --- state -------------------------------------------------------------------------
     def reset(self, root_pos_m, root_quat_xyzw, pose: np.ndarray, root_linvel_m_s=(0.0, 0.0, 0.0)) -> None:
@@ -178,7 +177,7 @@ class World:
                 c.resetJointState(self.uid, joint, float(pose[self.layout.motor_coord[m]]), 0.0)
         self.steps = 0
         self._torque[:] = 0.0
-        self._load, self._sent = self._no_load, True
+        self._pending = None
         self._fresh = False
 
     @property
@@ -194,7 +193,7 @@ class World:
         flat = np.fromiter(chain(base_pos, base_quat, _flatten(map(_JOINT_POSITION, joints)), base_ang, base_lin,
                                  _flatten(map(_JOINT_RATE, joints))), np.float64, self._state_size)
         self._q, self._qd = flat[:tree.n_positions], flat[tree.n_positions:]
-        forward_kinematics(tree.index, tree.params, self._q, self._qd, self._frames)
+        forward_kinematics(tree.index, tree.params, self._q, self._qd, self._frames, self._subspace)
         self._fresh = True
         segments = self._frames[self._segment_rows]
         return BodyState(self.time_s, segments[:, POS], segments[:, QUAT], segments[:, LINVEL], segments[:, ANGVEL])
@@ -203,11 +202,11 @@ class World:
         if not self._fresh:
             self.read_state()
 
-    def kinematics(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The generalised positions and rates now (see ``articulation.Tree``) and every body's
-        frame (``articulation.FRAME_COLUMNS``); views, valid until the next step."""
+    def kinematics(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The generalised positions and rates now (see ``articulation.Tree``), every body's frame
+        and the rates' motion subspace (``articulation.forward_kinematics``); valid until the next step."""
         self._ensure_fresh()
-        return self._q, self._qd, self._frames
+        return self._q, self._qd, self._frames, self._subspace
 
     def joint_positions(self) -> np.ndarray:
         """Current pose as PyBullet reports it: ball joints as quaternions, hinges as angles,
@@ -229,15 +228,13 @@ class World:
         base wrench, the joints' added to the motor torques. (PyBullet's per-link external force
         would take its lever arm from link frames it updates only when asked, at a cost.)"""
         self._ensure_fresh()
-        tree = self.tree
-        load = generalized_forces(tree.index, tree.params, self._frames, tree.n_dof, self._segment_rows, force_n,
+        load = generalized_forces(self.tree.index, self._frames, self._subspace, self._segment_rows, force_n,
                                   torque_nm, at_m)
         uid, cid, frame = self.uid, self._cid, pybullet.WORLD_FRAME
         pybullet.applyExternalForce(uid, -1, load[3:6].tolist(), self._q[0:3].tolist(), frame, cid)
         pybullet.applyExternalTorque(uid, -1, load[0:3].tolist(), frame, cid)
         load[0:6] = 0.0
-        self._load = load if self._sent else self._load + load   # PyBullet adds up repeated pushes too
-        self._sent = False
+        self._add_pending(load)
 
     def set_targets(self, pose: np.ndarray, rates: np.ndarray) -> None:
         """Convert a desired pose and its rates into the joints' targets (at control rate)."""
@@ -250,27 +247,25 @@ class World:
         next step only, so this must be called before every physics step."""
         self._ensure_fresh()
         tree = self.tree
-        mass, bias = mass_matrix_and_bias(tree.index, tree.params, self._frames, tree.n_dof, self.gravity_m_s2)
+        mass, bias = mass_matrix_and_bias(tree.index, tree.params, self._frames, self._subspace, self.gravity_m_s2)
         self._torque = stable_pd_torques(mass, bias, tree.index, self._q, self._qd, self._target_q, self._target_qd,
                                          self._gains, self.dt_s)
-        self._send(self._torque + self._load)
+        self._add_pending(self._torque)
 
-    def _send(self, torque: np.ndarray) -> None:
-        """Joint torques for the next step (PyBullet adds up what it is sent and clears it after the step)."""
-        flat = torque.tolist()
-        pybullet.setJointMotorControlMultiDofArray(self.uid, self._joints, pybullet.TORQUE_CONTROL,
-                                                   forces=[flat[a:b] for a, b in self._torque_cuts],
-                                                   physicsClientId=self._cid)
-        self._sent = True
+    def _add_pending(self, generalised: np.ndarray) -> None:
+        self._pending = generalised if self._pending is None else self._pending + generalised
 
     def step(self) -> None:
-        if not self._sent:
-            self._send(self._load)  # wrenches applied with no drive() this step
+        if self._pending is not None:
+            # All joint torques in one call; PyBullet clears them after the step.
+            flat = self._pending.tolist()
+            pybullet.setJointMotorControlMultiDofArray(self.uid, self._joints, pybullet.TORQUE_CONTROL,
+                                                       forces=[flat[a:b] for a, b in self._torque_cuts],
+                                                       physicsClientId=self._cid)
+            self._pending = None
         pybullet.stepSimulation(physicsClientId=self._cid)
         self.steps += 1
         self._fresh = False
-        self._load = self._no_load
-        self._sent = True
 
     def close(self) -> None:
         with contextlib.suppress(Exception):
