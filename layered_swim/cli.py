@@ -40,12 +40,14 @@ def _parser() -> argparse.ArgumentParser:
                      help="inhaled air in litres, on top of the residual volume (default 3)")
     _water_options(run)
     run.add_argument("--tempo", type=float, default=1.0, help="stroke rate multiplier (default 1)")
+    _backend_option(run)
 
     sub.add_parser("strokes", help="list the available strokes")
 
     validate = sub.add_parser("validate", help="compare the model with measurements")
     validate.add_argument("what", choices=("drag",), help="drag: towed passive drag vs Narita et al. 2017")
     validate.add_argument("--json", action="store_true")
+    _backend_option(validate)
 
     calibrate = sub.add_parser("calibrate", help="measure each perturbation sequence's turn per cycle (Yang 4.3)")
     calibrate.add_argument("--stroke", required=True, help="stroke name or path to a stroke .yaml")
@@ -114,6 +116,10 @@ def _water_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--physics-hz", type=int, default=480)
 
 
+def _backend_option(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--backend", default="plate", help="fluid model (default plate: thin plates + buoyancy)")
+
+
 def _current_option(command: argparse.ArgumentParser) -> None:
     command.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
 
@@ -151,7 +157,8 @@ def _cmd_run(args) -> None:
 
     out_dir = args.out or default_out_dir(args.stroke)
     result = run_swim(args.stroke, args.seconds, args.lung_air_l, args.density, out_dir, args.seed,
-                      args.physics_hz, args.tempo, fluid=args.fluid, progress=not args.json and sys.stderr.isatty())
+                      args.physics_hz, args.tempo, fluid=args.fluid, progress=not args.json and sys.stderr.isatty(),
+                      backend=args.backend)
     if args.json:
         print(json.dumps({**result, "out_dir": str(out_dir)}, allow_nan=False))
         return
@@ -162,7 +169,7 @@ def _cmd_run(args) -> None:
 def _cmd_strokes(args) -> None:
     from layered_swim.body.model import load_body
     from layered_swim.config import ConfigError
-    from layered_swim.control.pose import joint_layout
+    from layered_swim.body.layout import joint_layout
     from layered_swim.control.stroke import available_strokes, load_stroke
 
     layout = joint_layout(load_body())
@@ -181,9 +188,11 @@ def _cmd_strokes(args) -> None:
 def _cmd_validate(args) -> None:
     from layered_swim.analysis.drag import REFERENCE_PASSIVE_DRAG_N_S2_M2, towed_drag
     from layered_swim.body.model import load_body
+    from layered_swim.fluid import make_fluid
     from layered_swim.fluid.medium import Medium
+    from layered_swim.sim.simulation import SimConfig
 
-    rows = towed_drag(load_body(), Medium())
+    rows = towed_drag(make_fluid(args.backend, load_body(), Medium(), SimConfig().gravity_m_s2))
     if args.json:
         print(json.dumps(rows))
         return
@@ -228,8 +237,9 @@ def _size(text: str) -> tuple[int, int]:
 
 def _cmd_calibrate(args) -> None:
     from layered_swim.body.model import load_body
-    from layered_swim.control.calibration import calibrate, calibration_path, save_table
-    from layered_swim.control.pose import joint_layout
+    from layered_swim.analysis.calibrate import calibrate
+    from layered_swim.control.calibration import calibration_path, save_table
+    from layered_swim.body.layout import joint_layout
     from layered_swim.control.stroke import load_stroke
 
     stroke = load_stroke(args.stroke, joint_layout(load_body()))
@@ -243,9 +253,7 @@ def _cmd_calibrate(args) -> None:
 
 def _cmd_follow(args) -> None:
     from layered_swim.control.layered import Layers
-    from layered_swim.tasks import follow_run
-
-    from layered_swim.runs import default_out_dir
+    from layered_swim.runs import default_out_dir, follow_run
 
     out = args.out or str(default_out_dir(f"follow-{Path(args.trajectory).stem}"))
     result = follow_run(args.trajectory, args.stroke, Layers.parse(args.layers), _vector(args.current, "--current"),
@@ -261,7 +269,8 @@ def _cmd_follow(args) -> None:
 
 def _cmd_goal(args) -> None:
     from layered_swim.control.layered import Layers
-    from layered_swim.tasks import GOAL_METRICS, goal_run
+    from layered_swim.runs import goal_run
+    from layered_swim.tasks.goal import GOAL_METRICS
 
     result = goal_run(args.pool, args.stroke, _vector(args.current, "--current"), Layers.parse(args.layers))
     if args.json:

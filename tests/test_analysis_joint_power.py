@@ -3,9 +3,9 @@ a swim: joint work = change of kinetic and potential energy - work of the water.
 import numpy as np
 import pytest
 
-from layered_swim.control.pose import quat_rotate
-from layered_swim.runs import build_swim
-from layered_swim.sim.recorder import Recorder
+from layered_swim.geometry import quat_rotate
+from layered_swim.episode import Episode
+from layered_swim.recorder import Recorder
 
 SECONDS = 2.0
 
@@ -21,22 +21,23 @@ def mechanical_energy_j(body, state) -> float:
 
 
 def test_joint_work_closes_the_energy_balance():
-    sim = build_swim("breaststroke").sim
+    episode = Episode("breaststroke")
+    sim = episode.sim
     try:
         recorder = Recorder(sim, joint_work=True)
         start = mechanical_energy_j(sim.body, sim.state)
         water_j = 0.0
         for _ in range(int(SECONDS * sim.config.physics_hz)):
             before = sim.state
-            sim.step()
+            episode.step()
             recorder(sim)
-            force, torque = sim.fluid.wrenches(before.pos_m, before.quat_xyzw, before.linvel_m_s, before.angvel_rad_s)
+            force, torque = sim.fluid_now.force_n, sim.fluid_now.torque_nm   # what the water did in that step
             after = sim.state
             water_j += np.sum(force * (before.linvel_m_s + after.linvel_m_s) / 2
                               + torque * (before.angvel_rad_s + after.angvel_rad_s) / 2) / sim.config.physics_hz
         gained_j = mechanical_energy_j(sim.body, sim.state) - start
     finally:
-        sim.close()
+        episode.close()
     joints_j = recorder.arrays()["joint_work_j"][-1]
     assert joints_j > 1000.0                      # the stroke does real work on the water
     # PyBullet's default body damping takes the rest (joint work slightly above the balance)

@@ -10,7 +10,7 @@ from layered_swim.analysis.stroke_metrics import (SwimmerInfo, amplitude, analyz
                                                   pitch_deg, propelling_efficiency, propulsive_resistive_n,
                                                   reach_along_body_m, speed_fluctuation_pct, travel_direction)
 from layered_swim.config import ConfigError
-from layered_swim.control.pose import quat_multiply
+from layered_swim.geometry import quat_multiply
 from layered_swim.sim.simulation import PRONE_QUAT_XYZW
 
 HZ = 120

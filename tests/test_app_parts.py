@@ -114,10 +114,10 @@ def test_session_switches_apply_to_the_running_simulation(session):
     session.toggle_layer("cycle")
     session.toggle_layer("palm")
     session.next_current()
-    assert session.sim.medium.current_m_s == (0.0, 0.3, 0.0)
+    assert session.sim.fluid.medium.current_m_s == (0.0, 0.3, 0.0)
     session.next_density()
-    assert session.sim.medium.rho_kg_m3 == pytest.approx(1023.3)
-    assert session.sim.fluid.medium is session.sim.medium
+    assert session.sim.fluid.medium.rho_kg_m3 == pytest.approx(1023.3)
+    assert session.sim.fluid.medium == session._medium()
     session.current_index = session.density_index = 0
     session.step(480)
     where = session.com_m

@@ -133,9 +133,9 @@ def test_keys_change_the_state(window):
         press(window, symbol)
         assert getattr(s.sim.controller.layers, layer) != before
     press(window, key.U)
-    assert s.current_index == 1 and s.sim.medium.current_m_s == (0.0, 0.3, 0.0)
+    assert s.current_index == 1 and s.sim.fluid.medium.current_m_s == (0.0, 0.3, 0.0)
     press(window, key.D)
-    assert s.sim.medium.rho_kg_m3 == pytest.approx(1023.3)
+    assert s.sim.fluid.medium.rho_kg_m3 == pytest.approx(1023.3)
     press(window, key.SPACE)
     assert s.paused
     t = s.sim.time_s

@@ -3,7 +3,7 @@ import numpy as np
 import pybullet
 import pytest
 
-from layered_swim.runs import build_swim
+from layered_swim.episode import Episode
 from layered_swim.sim.articulation import (ANGVEL, LINVEL, POS, QUAT, ROT, generalized_forces,
                                            mass_matrix_and_bias)
 
@@ -13,10 +13,10 @@ GRAVITY_M_S2 = 9.81
 @pytest.fixture(scope="module")
 def swimming():
     """A front crawl 1.3 s in: every joint moving."""
-    sim = build_swim("front_crawl").sim
-    sim.run(1.3)
-    yield sim
-    sim.close()
+    episode = Episode("front_crawl")
+    episode.run(1.3)
+    yield episode.sim
+    episode.close()
 
 
 def test_forward_kinematics_matches_pybullet(swimming):

@@ -8,7 +8,7 @@ from pybullet_utils.bullet_client import BulletClient
 from layered_swim.body.model import DEFAULT_BODY_FILE, load_body
 from layered_swim.body.urdf import axis_joint_name, write_urdf
 from layered_swim.config import ConfigError
-from layered_swim.control.pose import joint_layout
+from layered_swim.body.layout import joint_layout
 
 ROOT_DOF = 6
 

@@ -3,8 +3,8 @@ import math
 import numpy as np
 import pytest
 
-from layered_swim.fluid.buoyancy import (buoyancy_wrenches, equal_volume_semi_axes,
-                                         submerged_fraction_and_centre)
+from layered_swim.body.model import equal_volume_semi_axes
+from layered_swim.fluid.buoyancy import buoyancy_wrenches, submerged_fraction_and_centre
 from layered_swim.fluid.induced_flow import induced_flow
 
 RHO = 1000.0

@@ -1,20 +1,14 @@
 """Yang's floater / sinker transition with the whole body: lung air decides."""
 import numpy as np
 
-from layered_swim.runs import build_swim
-from layered_swim.sim.recorder import Recorder
+from layered_swim.episode import Episode
+from layered_swim.runs import record
 
 SECONDS = 6.0
 
 
 def float_rest(lung_air_l: float) -> dict[str, np.ndarray]:
-    sim = build_swim("rest", lung_air_l=lung_air_l).sim
-    recorder = Recorder(sim)
-    try:
-        sim.run(SECONDS, every_step=recorder)
-    finally:
-        sim.close()
-    return recorder.arrays()
+    return record(Episode("rest", lung_air_l=lung_air_l), SECONDS).arrays()
 
 
 def test_floater_with_three_litres():

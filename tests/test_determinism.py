@@ -4,7 +4,7 @@ import pytest
 
 from layered_swim.control.stroke import available_strokes
 from layered_swim.runs import run_swim
-from layered_swim.sim.recorder import log_hash
+from layered_swim.recorder import log_hash
 
 SECONDS = 1.5
 

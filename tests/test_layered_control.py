@@ -8,19 +8,28 @@ from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, load
 from layered_swim.control.calibration import CalibrationTable, load_table
 from layered_swim.control.layered import CycleChoice, Layers, LayeredController, fixed_weights
-from layered_swim.control.pose import joint_layout, quat_multiply
+from layered_swim.body.layout import joint_layout
+from layered_swim.geometry import quat_multiply
 from layered_swim.control.rules import arm_indices, rule_offsets
 from layered_swim.control.steering import Attitude, wanted_turns
 from layered_swim.control.stroke import (JointKeys, RulesSpec, StrokeSpec, build_stroke, load_stroke, mirrored_keys,
                                          stroke_path)
 from layered_swim.control.policy import Lead, TargetPolicy, TempoControl
 from layered_swim.control.targets import FixedTarget, load_trajectory
-from layered_swim.runs import build_swim
+from layered_swim.episode import Episode
 from layered_swim.sim.simulation import PRONE_QUAT_XYZW
-from layered_swim.sim.world import BodyState
+from layered_swim.state import BodyState, Segments
+from layered_swim.tasks import FollowTarget
 
 BODY = load_body()
 LAYOUT = joint_layout(BODY)
+
+
+def still_state(mass_fraction=None) -> BodyState:
+    """All 16 segments at the origin, prone, at rest."""
+    segments = BODY.segments if mass_fraction is None else Segments(BODY.segment_names, mass_fraction)
+    return BodyState(0.0, np.zeros((16, 3)), np.tile(PRONE_QUAT_XYZW, (16, 1)), np.zeros((16, 3)), np.zeros((16, 3)),
+                     segments)
 
 
 def table(yaw_turns_deg=(0.0, 2.0, 4.0, 6.0, 8.0)) -> CalibrationTable:
@@ -80,14 +89,14 @@ def test_blending_adds_weighted_offsets_for_the_whole_cycle():
     controller = LayeredController(stroke, LAYOUT, arm_indices(BODY, LAYOUT), fixed_weights({"yaw_left": 0.5}),
                                    Layers(cycle=True, palm=False, reach=False))
     controller.reset()
-    state = BodyState(0.0, np.zeros((16, 3)), np.tile(PRONE_QUAT_XYZW, (16, 1)), np.zeros((16, 3)), np.zeros((16, 3)))
-    controller.desired(0.0, None)
-    pose, _ = controller.desired(0.3 * stroke.period_s, state)   # cycle 0: no weights yet
+    state = still_state()
+    controller.desired(0.0, None, None)
+    pose, _ = controller.desired(0.3 * stroke.period_s, state, np.zeros((16, 3)))   # cycle 0: no weights yet
     basic, _ = stroke.pose(0.3)
     np.testing.assert_allclose(pose, LAYOUT.clamp(basic))
     t = (1.3) * stroke.period_s                                   # cycle 1: weights chosen at its start
     state.time_s = t
-    pose, _ = controller.desired(t, state)
+    pose, _ = controller.desired(t, state, np.zeros((16, 3)))
     offset, _ = stroke.perturbations["yaw_left"].at(1.3)
     np.testing.assert_allclose(pose, LAYOUT.clamp(basic + 0.5 * offset))
     assert controller.choice.weights == {"yaw_left": 0.5}
@@ -101,10 +110,10 @@ def test_glide_holds_the_pose_but_the_joints_that_keep_moving():
     def glide(cycle, state, mean_roll_rad):
         return CycleChoice(glide=True)
     controller = LayeredController(stroke, LAYOUT, arm_indices(BODY, LAYOUT), glide, Layers(cycle=True, palm=False, reach=False))
-    state = BodyState(0.0, np.zeros((16, 3)), np.tile(PRONE_QUAT_XYZW, (16, 1)), np.zeros((16, 3)), np.zeros((16, 3)))
-    pose, rate = controller.desired(0.0, state)
+    state = still_state()
+    pose, rate = controller.desired(0.0, state, np.zeros((16, 3)))
     state.time_s = 0.3 * stroke.period_s
-    pose, rate = controller.desired(state.time_s, state)
+    pose, rate = controller.desired(state.time_s, state, np.zeros((16, 3)))
     held, _ = stroke.pose(0.0)
     running, running_rate = stroke.pose(0.3)
     np.testing.assert_allclose(pose[~moving], LAYOUT.clamp(held)[~moving])       # the arms wait
@@ -115,9 +124,10 @@ def test_glide_holds_the_pose_but_the_joints_that_keep_moving():
 
 
 def test_steering_settings_come_from_the_stroke_file_and_leave_its_calibration_fresh():
-    crawl = build_swim("front_crawl", target=FixedTarget([5.0, 0.0, -0.3]))
+    crawl = Episode("front_crawl", FollowTarget(FixedTarget([5.0, 0.0, -0.3])))
+    crawl.close()
     steering = crawl.stroke.steering
-    gains = crawl.sim.controller.policy.gains
+    gains = crawl.controller.policy.gains
     assert (gains.yaw_fraction, gains.pitch_fraction, gains.roll_fraction) == (
         steering.yaw_fraction, steering.pitch_fraction, steering.roll_fraction)
     spec = load(StrokeSpec, stroke_path("front_crawl"))
@@ -127,7 +137,7 @@ def test_steering_settings_come_from_the_stroke_file_and_leave_its_calibration_f
 
 def _facing_change(arm, offsets, quat, flow_dir):
     """First-order change of |palm normal . flow| when the palm offsets are applied."""
-    from layered_swim.control.pose import quat_rotate
+    from layered_swim.geometry import quat_rotate
 
     normal = quat_rotate(quat[arm.hand], np.array([0.0, 1.0, 0.0]))
     axes = quat_rotate(quat[arm.forearm], arm.wrist_axes)
@@ -144,10 +154,10 @@ def test_palm_rule_faces_a_helpful_flow_and_slices_a_hindering_one(hand_velocity
     velocity[arm.hand] = hand_velocity          # the hand sweeps back: the water flows past it toward +x
     flow_dir = -velocity[arm.hand] / np.linalg.norm(velocity[arm.hand])
     none = np.zeros(LAYOUT.size)
-    helpful = rule_offsets(none, arms, RulesSpec(), quat, velocity, np.zeros(3), np.array([1.0, 0.0, 0.0]), 0.01)
+    helpful = rule_offsets(none, arms, RulesSpec(), quat, velocity, np.zeros((16, 3)), np.array([1.0, 0.0, 0.0]), 0.01)
     assert _facing_change(arm, helpful, quat, flow_dir) > 0          # palm turns into the flow
     assert helpful[arm.elbow_coord] < 0                              # and the arm reaches further
-    hindering = rule_offsets(none, arms, RulesSpec(), quat, velocity, np.zeros(3), np.array([-1.0, 0.0, 0.0]), 0.01)
+    hindering = rule_offsets(none, arms, RulesSpec(), quat, velocity, np.zeros((16, 3)), np.array([-1.0, 0.0, 0.0]), 0.01)
     assert _facing_change(arm, hindering, quat, flow_dir) < 0        # palm slices
     assert hindering[arm.elbow_coord] > 0                            # and the arm stays closer
 
@@ -159,11 +169,11 @@ def test_rule_offsets_fade_and_stay_within_their_limits():
     velocity[arms[0].hand] = [-1.0, -0.5, 0.3]
     offsets = np.zeros(LAYOUT.size)
     for _ in range(2000):                        # a long push saturates at max_deg
-        offsets = rule_offsets(offsets, arms, RulesSpec(), quat, velocity, np.zeros(3), np.array([1.0, 0, 0]), 0.01)
+        offsets = rule_offsets(offsets, arms, RulesSpec(), quat, velocity, np.zeros((16, 3)), np.array([1.0, 0, 0]), 0.01)
     assert np.abs(np.degrees(offsets)).max() == pytest.approx(RulesSpec().palm.max_deg)
     still = np.zeros((16, 3))                    # no flow past the hands: the offsets fade away
     for _ in range(200):
-        offsets = rule_offsets(offsets, arms, RulesSpec(), quat, still, np.zeros(3), np.array([1.0, 0, 0]), 0.01)
+        offsets = rule_offsets(offsets, arms, RulesSpec(), quat, still, np.zeros((16, 3)), np.array([1.0, 0, 0]), 0.01)
     assert np.abs(offsets).max() < 1e-3
 
 
@@ -180,14 +190,13 @@ def test_missing_or_stale_calibration_is_a_clear_error(tmp_path):
 
 def test_short_follow_gets_closer_to_a_fixed_target():
     target = FixedTarget([6.0, 3.0, -0.2])
-    sim = build_swim("breaststroke", target=target).sim
-    mass = BODY.mass_kg / BODY.mass_kg.sum()
+    episode = Episode("breaststroke", FollowTarget(target))
     try:
-        start = np.linalg.norm(mass @ sim.state.pos_m - target.position(0.0))
-        sim.run(6.0)
-        end = np.linalg.norm(mass @ sim.state.pos_m - target.position(0.0))
+        start = np.linalg.norm(episode.sim.state.com_m - target.position(0.0))
+        episode.run(6.0)
+        end = np.linalg.norm(episode.sim.state.com_m - target.position(0.0))
     finally:
-        sim.close()
+        episode.close()
     assert end < start - 2.5
 
 
@@ -207,13 +216,13 @@ def test_palm_rule_adds_forward_displacement():
     target = FixedTarget([100.0, 0.0, -0.2])
     travelled = {}
     for layers in ("basic", "basic,palm"):
-        sim = build_swim("breaststroke", target=target, layers=Layers.parse(layers)).sim
+        episode = Episode("breaststroke", FollowTarget(target), layers=Layers.parse(layers))
         try:
-            start = sim.state.pos_m[0, 0]
-            sim.run(10.0)
-            travelled[layers] = sim.state.pos_m[0, 0] - start
+            start = episode.sim.state.pos_m[0, 0]
+            episode.run(10.0)
+            travelled[layers] = episode.sim.state.pos_m[0, 0] - start
         finally:
-            sim.close()
+            episode.close()
     assert travelled["basic,palm"] >= 1.10 * travelled["basic"]
 
 
@@ -225,9 +234,8 @@ def test_lead_looks_further_ahead_where_the_path_bends():
 
 
 def test_policy_asks_for_thrust_only_when_far_and_ahead():
-    mass = np.full(16, 1 / 16)
-    state = BodyState(0.0, np.zeros((16, 3)), np.tile(PRONE_QUAT_XYZW, (16, 1)), np.zeros((16, 3)), np.zeros((16, 3)))
-    choice = lambda point: TargetPolicy(FixedTarget(point), table(), "prone", mass)(0, state, 0.0)  # noqa: E731
+    state = still_state(np.full(16, 1 / 16))
+    choice = lambda point: TargetPolicy(FixedTarget(point), table(), "prone")(0, state, 0.0)  # noqa: E731
     assert choice((5.0, 0.0, 0.0)).thrust_demand == pytest.approx(1.0)     # far, straight ahead
     assert choice((0.1, 0.0, 0.0)).thrust_demand == pytest.approx(0.0)     # there already
     assert choice((-5.0, 0.0, 0.0)).thrust_demand == pytest.approx(0.0)    # behind: turn first

@@ -5,9 +5,10 @@ import pybullet
 import pytest
 
 from layered_swim.body.model import load_body
-from layered_swim.control.pd import _ball_error
-from layered_swim.control.pose import joint_layout, quat_multiply
-from layered_swim.runs import build_swim
+from layered_swim.sim.pd import _ball_error
+from layered_swim.body.layout import joint_layout
+from layered_swim.geometry import quat_multiply
+from layered_swim.episode import Episode
 from layered_swim.sim.simulation import UPRIGHT_QUAT_XYZW
 from layered_swim.sim.world import World
 
@@ -68,9 +69,10 @@ def test_ball_error_is_the_short_rotation_in_the_child_frame():
 def test_stable_pd_matches_pybullets():
     """Our stable PD drives the swimming body as PyBullet's STABLE_PD_CONTROL would, to a few
     parts in a million of one step's change in the joint rates."""
-    sim = build_swim("front_crawl").sim
+    episode = Episode("front_crawl")
+    sim = episode.sim
     try:
-        sim.run(1.3)
+        episode.run(1.3)
         world, tree = sim.world, sim.world.tree
         before = world.kinematics()[1].copy()
         target_q, target_qd, gains = world._target_q, world._target_qd, world._gains

@@ -6,7 +6,7 @@ import pytest
 
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError
-from layered_swim.control.pose import joint_layout
+from layered_swim.body.layout import joint_layout
 from layered_swim.control.stroke import available_strokes, load_stroke
 
 LAYOUT = joint_layout(load_body())

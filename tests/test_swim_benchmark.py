@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from layered_swim.analysis.swim_benchmark import (
+from layered_swim.tasks.swim_benchmark import (
     ROLL_TOLERANCE_DEG, START_DEPTH_M, SWIM_PUBLISHED, episode_metrics, goal_position, goal_tasks,
     intermediate_goal, intermediate_goals, pool, straight_line_metrics,
 )

@@ -1,17 +1,18 @@
 """A short swim goes forward: the strokes, the PD and the fluid together make thrust."""
 import pytest
 
-from layered_swim.runs import build_swim
+from layered_swim.episode import Episode
 
 SECONDS = 4.0
 
 
 @pytest.mark.parametrize("stroke", ["breaststroke", "front_crawl"])
 def test_short_swim_makes_forward_progress(stroke):
-    sim = build_swim(stroke).sim
+    episode = Episode(stroke)
+    sim = episode.sim
     try:
         start_x = sim.state.pos_m[0, 0]
-        sim.run(SECONDS)
+        episode.run(SECONDS)
         travelled_m = sim.state.pos_m[0, 0] - start_x
         depth_m = -sim.state.pos_m[0, 2]
     finally:

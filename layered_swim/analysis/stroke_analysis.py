@@ -13,13 +13,16 @@ from pathlib import Path
 from layered_swim.analysis import plots, report
 from layered_swim.analysis.drag import towed_drag
 from layered_swim.analysis.files import write_csv
-from layered_swim.analysis.metrics import SETTLE_S
+from layered_swim.tasks.metrics import SETTLE_S
 from layered_swim.analysis.reference_ranges import ranges_for
 from layered_swim.analysis.stroke_metrics import SwimmerInfo, analyze_log
 from layered_swim.analysis.sweep import file_sha256, run_sweep
 from layered_swim.config import ConfigError
 from layered_swim.control.stroke import stroke_path
-from layered_swim.runs import _check_seconds, _write_json, build_swim, make_medium, record, resolved_config
+from layered_swim.episode import Episode
+from layered_swim.fluid import make_fluid
+from layered_swim.runs import check_seconds, make_medium, record, resolved_config, write_json
+from layered_swim.tasks import FreeSwim
 
 ANALYSIS_LOG_HZ = 120      # ~100 samples per stroke cycle for the profiles
 PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_figure,
@@ -30,7 +33,7 @@ def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | N
                     current_m_s=(0.0, 0.0, 0.0), fluid: str = "fresh_water", settle_s: float = SETTLE_S,
                     seed: int = 0, physics_hz: int = 480) -> dict:
     """The resolved, JSON-able configuration of one analysis (also its cache key)."""
-    _check_seconds(seconds)
+    check_seconds(seconds)
     if not (math.isfinite(settle_s) and 0.0 <= settle_s < seconds):
         raise ConfigError(f"settle time must be at least 0 and shorter than the swim ({seconds:g} s), got {settle_s}")
     return {"stroke": stroke, "stroke_file_sha256": file_sha256(stroke_path(stroke)), "seconds": float(seconds),
@@ -39,20 +42,21 @@ def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | N
 
 
 def analyze_stroke(config: dict, progress: bool = False) -> dict:
-    medium = make_medium(config["fluid"], config["density_kg_m3"]).with_(current_m_s=tuple(config["current_m_s"]))
-    setup = build_swim(config["stroke"], medium=medium, physics_hz=config["physics_hz"], seed=config["seed"])
-    sim = setup.sim
-    recorder = record(sim, config["seconds"], ANALYSIS_LOG_HZ, progress, joint_work=True)
-    posture = setup.stroke.start.posture
-    result = analyze_log(recorder.arrays(), SwimmerInfo(sim.body.segment_names, posture, setup.stroke.period_s,
+    medium = make_medium(config["fluid"], config["density_kg_m3"], config["current_m_s"])
+    episode = Episode(config["stroke"], FreeSwim(), medium=medium, physics_hz=config["physics_hz"], seed=config["seed"])
+    sim, stroke = episode.sim, episode.stroke
+    recorder = record(episode, config["seconds"], ANALYSIS_LOG_HZ, progress, joint_work=True)
+    posture = stroke.start.posture
+    result = analyze_log(recorder.arrays(), SwimmerInfo(sim.body.segment_names, posture, stroke.period_s,
                                                         config["settle_s"]))
     summary = result["summary"]
     speed = summary["mean_speed_m_s"]["mean"]
     # The same body towed in a streamlined glide at the swimming speed: what the stroke adds.
-    summary["passive_drag_n"] = towed_drag(sim.body, sim.medium, (abs(speed),))[0]["drag_n"] if posture == "prone" else None
-    summary["nominal_stroke_rate_cpm"] = 60.0 / setup.stroke.period_s
-    return {"stroke": setup.stroke.name, "posture": posture, **result,
-            "config": resolved_config(setup, config, ANALYSIS_LOG_HZ)}
+    towed = make_fluid(sim.fluid.name, sim.body, sim.fluid.medium, sim.config.gravity_m_s2)
+    summary["passive_drag_n"] = towed_drag(towed, (abs(speed),))[0]["drag_n"] if posture == "prone" else None
+    summary["nominal_stroke_rate_cpm"] = 60.0 / stroke.period_s
+    return {"stroke": stroke.name, "posture": posture, **result,
+            "config": resolved_config(episode, config, ANALYSIS_LOG_HZ)}
 
 
 def comparisons(result: dict) -> list[dict]:
@@ -79,9 +83,9 @@ def write_analysis(result: dict, out_dir: str | Path) -> list[str]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     table = comparisons(result)
-    _write_json(out / "summary.json", {"stroke": result["stroke"], "posture": result["posture"],
+    write_json(out / "summary.json", {"stroke": result["stroke"], "posture": result["posture"],
                                        **result["summary"], "comparison": table})
-    _write_json(out / "config.json", result["config"])
+    write_json(out / "config.json", result["config"])
     write_csv(out / "cycles.csv", result["cycles"])
     profiles = result["profiles"]
     points = len(next(iter(profiles.values()))["mean"])

@@ -13,9 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from layered_swim.analysis.cycles import cycle_means, cycle_starts, resample_cycles
-from layered_swim.analysis.metrics import roll_deg
+from layered_swim.tasks.metrics import roll_deg
 from layered_swim.config import ConfigError
-from layered_swim.control.pose import quat_rotate
+from layered_swim.geometry import quat_rotate
 from layered_swim.control.steering import FORWARD_LOCAL
 
 PELVIS_LONG_AXIS_LOCAL = np.array([0.0, 0.0, 1.0])

@@ -15,7 +15,7 @@ import numpy as np
 from pydantic import PositiveFloat, NonNegativeFloat, field_validator, model_validator
 
 from layered_swim.config import ConfigError, Strict, Vec3, load
-from layered_swim.fluid.buoyancy import equal_volume_semi_axes
+from layered_swim.state import Segments
 
 DEFAULT_BODY_FILE = resources.files("layered_swim.body") / "swimmer.yaml"
 AXES_PER_JOINT_TYPE = {"ball": 3, "hinge": 1, "two_axis": 2}
@@ -169,6 +169,11 @@ class Body:
         return self.mass_kg / self.mass_kg.sum()
 
     @property
+    def segments(self) -> Segments:
+        """The segments by name with their mass shares, as every ``BodyState`` carries them."""
+        return Segments(self.segment_names, self.mass_fraction)
+
+    @property
     def total_volume_m3(self) -> float:
         return float(self.volume_m3.sum())
 
@@ -232,3 +237,14 @@ def resolve_body(spec: BodySpec, lung_air_l: float, source: str) -> Body:
         joints=tuple(joints), gimbal_mass_kg=spec.gimbal_mass_kg, lung_air_l=lung_air_l,
         source=source,
     )
+
+
+def equal_volume_semi_axes(half_extents_m, volume_m3):
+    """Ellipsoid semi-axes proportional to the box half extents with 4/3 pi abc = volume_m3.
+
+    half_extents_m (..., 3), volume_m3 (...) -> (..., 3).
+    """
+    half = np.asarray(half_extents_m, dtype=np.float64)
+    vol = np.asarray(volume_m3, dtype=np.float64)
+    scale = np.cbrt(3.0 * vol / (4.0 * np.pi * np.prod(half, axis=-1)))
+    return half * scale[..., None]

@@ -1,17 +1,12 @@
-"""Calibration by preprocessed simulation (Yang 4.3).
-
-For every perturbation sequence of a stroke, simulate the swimmer in still water at a grid of
-weights and tempos (tempo sets the swimming speed): a few basic cycles to settle, then a few
-cycles with the sequence at that weight. The change of the cycle-averaged heading (yaw), body
-pitch or shoulder roll per cycle, minus the unperturbed drift, is the sequence's turn. The table
-is written to ``strokes/calibration/<stroke>.yaml``; the per-cycle layer inverts it to pick the
-weight that turns the swimmer through the wanted angle. A table made from a different version of
+"""The per-cycle layer's calibration table (Yang 4.3): each perturbation sequence's turn per cycle
+at a grid of weights and tempos, read from ``strokes/calibration/<stroke>.yaml`` and inverted
+to pick the weight that turns the swimmer through the wanted angle. ``layered-swim calibrate``
+measures it (``layered_swim/analysis/calibrate.py``). A table made from a different version of
 the stroke file is stale: loading it is an error that says how to remake it.
 """
 from __future__ import annotations
 
 import math
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,16 +14,11 @@ import numpy as np
 import yaml
 
 from layered_swim.config import ConfigError, load_yaml
-from layered_swim.control.stroke import SEQUENCE_NAMES, STROKES_DIR, Stroke
+from layered_swim.control.stroke import STROKES_DIR, Stroke
 
 CALIBRATION_DIR = STROKES_DIR / "calibration"
 SEQUENCE_AXIS = {"yaw_left": ("yaw", 1.0), "yaw_right": ("yaw", -1.0), "pitch_up": ("pitch", 1.0),
                  "pitch_down": ("pitch", -1.0), "roll_left": ("roll", 1.0), "roll_right": ("roll", -1.0)}
-AXIS_INDEX = {"yaw": 0, "pitch": 1, "roll": 2}       # columns of a swim's (yaw, pitch, roll) change
-WEIGHTS = (0.0, 0.25, 0.5, 0.75, 1.0)
-TEMPOS = (0.7, 1.0)
-SETTLE_CYCLES = 3
-MEASURE_CYCLES = 2
 
 
 class CalibrationError(ConfigError):
@@ -120,75 +110,3 @@ def load_table(stroke: Stroke, directory: Path = CALIBRATION_DIR) -> Calibration
             raise CalibrationError(f"{path}: field 'turn_deg_per_cycle.{name}': expected {len(table.tempos)} rows "
                               f"of {len(table.weights)} finite numbers; {remake}")
     return table
-
-
-def _measure(job: tuple[str, str | None, float, float]) -> tuple:
-    """One calibration swim: (angle change per cycle about the sequence's axis, mean speed, the
-    last cycle's mean roll); with no sequence the change is (yaw, pitch, roll)."""
-    from layered_swim.control.layered import Layers, fixed_weights
-    from layered_swim.control.steering import attitude, wrap_angle
-    from layered_swim.runs import build_swim
-
-    stroke_name, sequence, weight, tempo = job
-    weights = {sequence: weight} if sequence else {}
-    setup = build_swim(stroke_name, policy=fixed_weights(weights, SETTLE_CYCLES, tempo), layers=Layers(cycle=True, palm=False, reach=False))
-    sim, controller = setup.sim, setup.sim.controller
-    posture = setup.stroke.start.posture
-    samples: dict[int, list[tuple[float, float, float]]] = {}
-    heading_prev, unwrapped = None, 0.0
-    mass = sim.body.mass_fraction
-    positions = []
-
-    def record(s) -> None:
-        nonlocal heading_prev, unwrapped
-        if s.steps % s.control_every:
-            return
-        att = attitude(s.state.quat_xyzw[0], s.state.quat_xyzw[2], posture)
-        if heading_prev is not None:
-            unwrapped += wrap_angle(att.heading_rad - heading_prev)
-        heading_prev = att.heading_rad
-        samples.setdefault(controller.cycle, []).append((unwrapped, att.pitch_rad, -att.roll_rad))
-        if controller.cycle >= SETTLE_CYCLES:
-            positions.append(mass @ s.state.pos_m)
-
-    seconds = (SETTLE_CYCLES + MEASURE_CYCLES) * setup.stroke.period_s / tempo
-    try:
-        sim.run(seconds + 0.5 / sim.config.control_hz, every_step=record)
-    finally:
-        sim.close()
-    before = np.mean(samples[SETTLE_CYCLES - 1], axis=0)
-    after = np.mean(samples[SETTLE_CYCLES + MEASURE_CYCLES - 1], axis=0)
-    axis = AXIS_INDEX[SEQUENCE_AXIS[sequence][0]] if sequence else 0
-    change = (after - before) / MEASURE_CYCLES
-    track = np.array(positions)
-    speed = float(np.linalg.norm(track[-1, :2] - track[0, :2]) / (len(track) / sim.config.control_hz))
-    return (float(change[axis]) if sequence else change.tolist()), speed, float(-after[2])   # roll: left up > 0
-
-
-def calibrate(stroke: Stroke, weights=WEIGHTS, tempos=TEMPOS, workers: int = 2, progress: bool = False) -> CalibrationTable:
-    """Simulate every sequence at every weight and tempo (in parallel) and build the table."""
-    sequences = [name for name in SEQUENCE_NAMES if name in stroke.perturbations]
-    if not sequences:
-        raise ConfigError(f"{stroke.source}: the stroke has no perturbation sequences to calibrate")
-    jobs = [(stroke.source, None, 0.0, tempo) for tempo in tempos]
-    jobs += [(stroke.source, seq, w, tempo) for seq in sequences for tempo in tempos for w in weights if w > 0]
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        results = pool.map(_measure, jobs)
-        if progress:
-            from tqdm import tqdm
-            results = tqdm(results, total=len(jobs), desc=f"calibrating {stroke.name}", unit="swim")
-        results = list(results)
-    baseline = {tempo: results[i][0] for i, tempo in enumerate(tempos)}      # drift with no perturbation
-    speeds = tuple(results[i][1] for i in range(len(tempos)))
-    rolls = tuple(results[i][2] for i in range(len(tempos)))
-    measured = iter(results[len(tempos):])
-    turn_rad = {}
-    for seq in sequences:
-        axis, sign = SEQUENCE_AXIS[seq]
-        k = AXIS_INDEX[axis]
-        rows = []
-        for tempo in tempos:
-            rows.append([0.0] + [sign * (next(measured)[0] - baseline[tempo][k]) for w in weights if w > 0])
-        turn_rad[seq] = np.array(rows)
-    return CalibrationTable(stroke.name, stroke.spec_sha256, tuple(weights), tuple(tempos), speeds, rolls,
-                            turn_rad)

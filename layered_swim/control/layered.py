@@ -8,16 +8,17 @@ water flowing past the hands. Layers can be switched off one by one (``Layers``)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Protocol
+from typing import Protocol
 
 import numpy as np
 
 from layered_swim.config import ConfigError
-from layered_swim.control.pose import JointLayout
 from layered_swim.control.rules import ArmIndices, rule_offsets
 from layered_swim.control.steering import forward_axis, shoulder_roll
 from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
-from layered_swim.sim.world import BodyState
+from layered_swim.control.targets import Target
+from layered_swim.geometry import unit_vector
+from layered_swim.state import BodyState, JointLayout
 
 
 BLEND_CYCLES = 0.15   # a new cycle's weights take over within this fraction of it
@@ -61,12 +62,10 @@ class WeightPolicy(Protocol):
 
 class LayeredController:
     def __init__(self, stroke: Stroke, layout: JointLayout, arms: list[ArmIndices], policy: WeightPolicy,
-                 layers: Layers = Layers()):
+                 layers: Layers = Layers(), target: Target | None = None):
+        """``target``: where the rules push toward; without one, straight ahead (scripted policies)."""
         self.stroke, self.layout, self.arms, self.policy, self.layers = stroke, layout, arms, policy, layers
-        # Set by whoever builds the swim (runs.build_swim): the water velocity near the swimmer and
-        # the unit direction it should go; without them the rules stay off.
-        self.water_velocity: Callable[[BodyState], np.ndarray] | None = None
-        self.desired_direction: Callable[[BodyState], np.ndarray] | None = None
+        self.target = target
         self.reset()
 
     def reset(self) -> None:
@@ -104,7 +103,8 @@ class LayeredController:
             if not self.layers.cycle:
                 self.choice = CycleChoice(tempo=self.choice.tempo)
 
-    def desired(self, time_s: float, state: BodyState | None) -> tuple[np.ndarray, np.ndarray]:
+    def desired(self, time_s: float, state: BodyState | None,
+                flow_m_s: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
         while self.cycle < 0 or (time_s - self.cycle_start_s) * self.cycles_per_s >= 1.0:
             self._start_cycle(state)
         phase = self.phase(time_s)
@@ -122,15 +122,21 @@ class LayeredController:
                 rate = rate + weight * offset_rate
         if state is not None:
             self._track_roll(state)
-            if (self.layers.palm or self.layers.reach) and self.water_velocity is not None:
+            if self.layers.palm or self.layers.reach:
                 dt_s = time_s - self._last_rule_time_s if self._last_rule_time_s is not None else 0.0
                 self._last_rule_time_s = time_s
                 desired = self.desired_direction(state)
                 self.rule_offsets = rule_offsets(self.rule_offsets, self.arms, self.stroke.rules, state.quat_xyzw,
-                                                 state.linvel_m_s, self.water_velocity(state), desired, dt_s,
+                                                 state.linvel_m_s, flow_m_s, desired, dt_s,
                                                  self.layers.palm, self.layers.reach, self._engagement(state, desired))
                 pose = pose + self.rule_offsets
         return self.layout.clamp(pose), rate * self.cycles_per_s
+
+    def desired_direction(self, state: BodyState) -> np.ndarray:
+        """Unit vector from the centre of mass to the target (the way the swimmer heads without one)."""
+        if self.target is None:
+            return forward_axis(state.quat("pelvis"), self.stroke.start.posture)
+        return unit_vector(self.target.position(state.time_s) - state.com_m)
 
     def _blended_weights(self, time_s: float) -> dict[str, float]:
         """This cycle's weights, eased in from the last cycle's over BLEND_CYCLES: a sequence need
@@ -150,14 +156,14 @@ class LayeredController:
         fading as the target moves abeam or the yaw weight grows. While turning, the per-cycle
         layer's left-right asymmetry is what is wanted, and rules that maximise both hands'
         thrust would even it out."""
-        forward = forward_axis(state.quat_xyzw[0], self.stroke.start.posture)
+        forward = forward_axis(state.quat("pelvis"), self.stroke.start.posture)
         turning = max(self.choice.weights.get("yaw_left", 0.0), self.choice.weights.get("yaw_right", 0.0))
         return max(0.0, float(forward @ desired)) ** 2 * max(0.0, 1.0 - turning) ** 3 * self.choice.thrust_demand
 
     def _track_roll(self, state: BodyState) -> None:
         """Accumulate the cycle's mean shoulder roll: a crawl rolls +-30 deg within a cycle, so
         steering reads the cycle average, not a sample."""
-        self._roll_sum += shoulder_roll(state.quat_xyzw[2])
+        self._roll_sum += shoulder_roll(state.quat("thorax"))
         self._roll_n += 1
 
 

@@ -15,9 +15,9 @@ import numpy as np
 
 from layered_swim.control.calibration import CalibrationTable
 from layered_swim.control.layered import CycleChoice
-from layered_swim.control.steering import Attitude, SteeringGains, attitude, wanted_turns, wrap_angle
+from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, wanted_turns, wrap_angle
 from layered_swim.control.targets import Target
-from layered_swim.sim.world import BodyState
+from layered_swim.state import BodyState
 
 
 @dataclass(frozen=True)
@@ -62,16 +62,16 @@ class Lead:
 
 
 class TargetPolicy:
-    def __init__(self, target: Target, table: CalibrationTable, posture: str, mass_fraction: np.ndarray,
+    def __init__(self, target: Target, table: CalibrationTable, posture: str,
                  gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead: Lead = Lead()):
         self.target, self.table, self.posture, self.lead = target, table, posture, lead
-        self.mass_fraction, self.gains, self.tempo_control = mass_fraction, gains, tempo
+        self.gains, self.tempo_control = gains, tempo
         self.last_wanted: dict[str, float] = {}
 
     def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
-        position = self.mass_fraction @ state.pos_m
+        position = state.com_m
         target = self.target.position(state.time_s + self.lead.seconds(self.target, state.time_s))
-        now = attitude(state.quat_xyzw[0], state.quat_xyzw[2], self.posture)
+        now = attitude_of(state, self.posture)
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); roll
         # averaged over the last cycle (a crawl rolls +-30 deg within it).
         att = Attitude(now.heading_rad, now.pitch_rad, now.roll_rad if mean_roll_rad is None else mean_roll_rad)

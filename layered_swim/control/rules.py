@@ -8,7 +8,7 @@
 * Arm reach: reach further (extend the elbow) while the hand's drag helps, keep the arm closer
   (flex the elbow) while it hinders.
 
-Pure functions of the body state, the water velocity and the desired direction.
+Pure functions of the body state, the water velocity at the hands and the desired direction.
 """
 from __future__ import annotations
 
@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from layered_swim.body.model import Body
-from layered_swim.control.pose import JointLayout, quat_rotate
+from layered_swim.geometry import quat_rotate
+from layered_swim.state import JointLayout
 from layered_swim.control.stroke import RulesSpec
 
 PALM_NORMAL_LOCAL = np.array([0.0, 1.0, 0.0])   # the hand box's thin axis
@@ -51,11 +52,12 @@ RULE_MEMORY_S = 0.25   # offsets fade with this time constant once the flow stop
 
 
 def rule_offsets(previous: np.ndarray, arms: list[ArmIndices], rules: RulesSpec, quat_xyzw: np.ndarray,
-                 linvel_m_s: np.ndarray, water_m_s: np.ndarray, desired_dir: np.ndarray, dt_s: float,
+                 linvel_m_s: np.ndarray, flow_m_s: np.ndarray, desired_dir: np.ndarray, dt_s: float,
                  palm: bool = True, reach: bool = True, engagement: float = 1.0) -> np.ndarray:
     """The rules' pose offsets (rad) after one control step of ``dt_s``: each offset moves along its
     rule's gradient at ``engagement * gain`` rad/s per unit gradient, fades with RULE_MEMORY_S and
-    stays within ``max_deg``; zero where a rule is off."""
+    stays within ``max_deg``; zero where a rule is off. ``flow_m_s`` (n, 3): the water velocity at
+    each segment, as the fluid backend found it."""
     palm = palm and rules.palm.enabled
     reach = reach and rules.reach.enabled
     if not (palm or reach):
@@ -63,7 +65,7 @@ def rule_offsets(previous: np.ndarray, arms: list[ArmIndices], rules: RulesSpec,
     pull = np.zeros_like(previous)
     limit = np.zeros_like(previous)
     for arm in arms:
-        flow = water_m_s - linvel_m_s[arm.hand]
+        flow = flow_m_s[arm.hand] - linvel_m_s[arm.hand]
         speed = float(np.linalg.norm(flow))
         if speed < MIN_FLOW_M_S:
             continue

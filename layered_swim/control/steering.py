@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from layered_swim.control.pose import quat_rotate
+from layered_swim.geometry import quat_rotate
+from layered_swim.state import BodyState
 
 FORWARD_LOCAL = {"prone": np.array([0.0, 0.0, 1.0]), "upright": np.array([1.0, 0.0, 0.0])}
 LATERAL_LOCAL = np.array([0.0, 1.0, 0.0])
@@ -42,6 +43,11 @@ def attitude(pelvis_quat: np.ndarray, thorax_quat: np.ndarray, posture: str) -> 
     forward = forward_axis(pelvis_quat, posture)
     return Attitude(math.atan2(forward[1], forward[0]), math.asin(max(-1.0, min(1.0, forward[2]))),
                     shoulder_roll(thorax_quat))
+
+
+def attitude_of(state: BodyState, posture: str) -> Attitude:
+    """The swimmer's heading, pitch and shoulder roll now."""
+    return attitude(state.quat("pelvis"), state.quat("thorax"), posture)
 
 
 @dataclass(frozen=True)

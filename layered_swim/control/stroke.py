@@ -19,8 +19,8 @@ from pydantic import Field, PositiveFloat, model_validator
 from scipy.interpolate import PchipInterpolator
 
 from layered_swim.config import ConfigError, Strict, available_files, file_path, load
-from layered_swim.control.pose import JointLayout
 from layered_swim.control.steering import SteeringGains
+from layered_swim.state import JointLayout, Start
 
 STROKES_DIR = Path(__file__).resolve().parents[2] / "strokes"
 TABLE_SAMPLES = 1024
@@ -135,6 +135,10 @@ class Stroke:
     def pose(self, phase: float) -> tuple[np.ndarray, np.ndarray]:
         """Pose (rad) and its rate per unit phase at ``phase`` in cycles (any real number)."""
         return self.basic.at(phase)
+
+    def start_state(self) -> Start:
+        """The file's start: posture, depth and speed, at the origin heading +x."""
+        return Start(self.start.posture, self.start.depth_m, self.start.speed_m_s)
 
 
 def _cyclic_curve(keys: dict[float, float], shift: float, smooth: bool, where: str):

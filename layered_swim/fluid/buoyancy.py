@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numba import njit
 
-from layered_swim.fluid.plate import quat_to_matrix
+from layered_swim.geometry import quat_to_rows
 
 
 @njit(cache=True)
@@ -25,12 +25,12 @@ def _submerged(pos, quat, semi, surface_z, exact):
     n = pos.shape[0]
     frac = np.empty(n)
     cob = np.empty((n, 3))
-    R = np.empty((3, 3))
+    R = np.empty(9)        # rotation matrix, row-major
     for i in range(n):
-        quat_to_matrix(quat[i], R)
-        n0 = semi[i, 0] * R[2, 0]
-        n1 = semi[i, 1] * R[2, 1]
-        n2 = semi[i, 2] * R[2, 2]
+        quat_to_rows(quat[i], R, True)
+        n0 = semi[i, 0] * R[6]
+        n1 = semi[i, 1] * R[7]
+        n2 = semi[i, 2] * R[8]
         s = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
         d = surface_z - pos[i, 2]
         if s > 0.0:
@@ -60,7 +60,7 @@ def _submerged(pos, quat, semi, surface_z, exact):
             u1 = k * n1 * semi[i, 1]
             u2 = k * n2 * semi[i, 2]
             for j in range(3):
-                cob[i, j] += R[j, 0] * u0 + R[j, 1] * u1 + R[j, 2] * u2
+                cob[i, j] += R[3 * j] * u0 + R[3 * j + 1] * u1 + R[3 * j + 2] * u2
     return frac, cob
 
 
@@ -113,14 +113,3 @@ def submerged_fraction_and_centre(pos_m, quat_xyzw, semi_axes_m, surface_z_m, ex
     """
     return _submerged(_f64(pos_m), _f64(quat_xyzw), _f64(semi_axes_m), float(surface_z_m),
                       bool(exact))
-
-
-def equal_volume_semi_axes(half_extents_m, volume_m3):
-    """Ellipsoid semi-axes proportional to the box half extents with 4/3 pi abc = volume_m3.
-
-    half_extents_m (..., 3), volume_m3 (...) -> (..., 3).
-    """
-    half = np.asarray(half_extents_m, dtype=np.float64)
-    vol = np.asarray(volume_m3, dtype=np.float64)
-    scale = np.cbrt(3.0 * vol / (4.0 * np.pi * np.prod(half, axis=-1)))
-    return half * scale[..., None]

@@ -1,8 +1,9 @@
-"""The fluid the swimmer is in: density, viscosity, surface, current and the induced-flow ratios."""
+"""What the water is: density, viscosity, surface height and current. How a fluid model turns that
+into forces (the thin plates' induced-flow ratios, an SPH particle size) is its backend's business."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -14,14 +15,6 @@ PRESETS_KG_M3_PA_S = {
     "seawater": (1023.3, 0.956e-3),
 }
 
-# Yang eq. 5 ratios (see README, "Calibration"). Along the body the boxes sit in each other's
-# wake, which the per-face model cannot see, so the nearby water moves with the swimmer at r_min
-# of its speed: calibrated so a towed streamlined body matches Narita et al. 2017's passive drag
-# 23.5 v^2 N. Broadside every face meets undisturbed water and the plate model alone gives a
-# realistic bluff-body drag (C_D ~1.2 on ~0.55 m^2), so r_max = 0.
-DEFAULT_R_MIN = 0.68
-DEFAULT_R_MAX = 0.0
-
 
 @dataclass(frozen=True)
 class Medium:
@@ -29,19 +22,11 @@ class Medium:
     eta_pa_s: float = PRESETS_KG_M3_PA_S["fresh_water"][1]
     surface_z_m: float = 0.0
     current_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    r_min: float = DEFAULT_R_MIN
-    r_max: float = DEFAULT_R_MAX
-    exact_buoyancy: bool = True
-    axial_induced_flow: bool = True   # False: Yang's eq. 5 entrains the whole velocity
-    gravity_m_s2: float = 9.81
-    patches_per_edge: int = field(default=1)
 
     def __post_init__(self):
         checks = {
             "density": (self.rho_kg_m3, 1.0, 20000.0),
             "viscosity": (self.eta_pa_s, 0.0, 100.0),
-            "r_min": (self.r_min, 0.0, 0.99),
-            "r_max": (self.r_max, 0.0, 0.99),
         }
         for name, (value, lo, hi) in checks.items():
             if not (math.isfinite(value) and lo <= value <= hi):

@@ -18,24 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
-
-@njit(cache=True)
-def quat_to_matrix(q, out):
-    """Write the rotation matrix of quaternion q = (x, y, z, w) into out (3, 3).
-
-    Columns of out are the body axes in world coordinates. q need not be unit.
-    """
-    x, y, z, w = q[0], q[1], q[2], q[3]
-    s = 2.0 / (x * x + y * y + z * z + w * w)
-    out[0, 0] = 1.0 - s * (y * y + z * z)
-    out[0, 1] = s * (x * y - z * w)
-    out[0, 2] = s * (x * z + y * w)
-    out[1, 0] = s * (x * y + z * w)
-    out[1, 1] = 1.0 - s * (x * x + z * z)
-    out[1, 2] = s * (y * z - x * w)
-    out[2, 0] = s * (x * z - y * w)
-    out[2, 1] = s * (y * z + x * w)
-    out[2, 2] = 1.0 - s * (x * x + y * y)
+from layered_swim.geometry import quat_to_rows
 
 
 @njit(cache=True)
@@ -79,11 +62,11 @@ def _plate_wrenches(pos, quat, linvel, angvel, half, flow, rho, eta, surface_z,
     torque = np.zeros((n, 3))
     n_tab = angles.shape[0]
     inv_step = (n_tab - 1) / angles[n_tab - 1]
-    R = np.empty((3, 3))
+    R = np.empty(9)        # rotation matrix, row-major: body axis c is column c
     kp = patches_per_edge
     inv_kp = 1.0 / kp
     for i in range(n):
-        quat_to_matrix(quat[i], R)
+        quat_to_rows(quat[i], R, True)
         wx, wy, wz = angvel[i, 0], angvel[i, 1], angvel[i, 2]
         fx_tot = 0.0
         fy_tot = 0.0
@@ -106,15 +89,15 @@ def _plate_wrenches(pos, quat, linvel, angvel, half, flow, rho, eta, surface_z,
             area = 4.0 * hf * hs * inv_kp * inv_kp
             if area <= 0.0:
                 continue
-            fax, fay, faz = R[0, jf], R[1, jf], R[2, jf]
-            sax, say, saz = R[0, js], R[1, js], R[2, js]
+            fax, fay, faz = R[jf], R[3 + jf], R[6 + jf]
+            sax, say, saz = R[js], R[3 + js], R[6 + js]
             # Patch half-edge heights for the submerged fraction.
             hz_f = abs(hf * inv_kp * faz)
             hz_s = abs(hs * inv_kp * saz)
             for sign in (1.0, -1.0):
-                nx = sign * R[0, k]
-                ny = sign * R[1, k]
-                nz = sign * R[2, k]
+                nx = sign * R[k]
+                ny = sign * R[3 + k]
+                nz = sign * R[6 + k]
                 hk = half[i, k]
                 for pf in range(kp):
                     uf = ((2 * pf + 1) * inv_kp - 1.0) * hf

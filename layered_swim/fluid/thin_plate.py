@@ -1,4 +1,4 @@
-"""The thin-plate fluid backend: body state -> one force and one torque per segment.
+"""The thin-plate fluid backend (``plate``): body state -> one force and one torque per segment.
 
 Flow at the swimmer = uniform current + Yang's swimmer-induced flow (eq. 5) driven by the
 whole-body centre-of-mass velocity and the pelvis long axis. Hydrodynamic forces come from
@@ -8,15 +8,52 @@ their arithmetic.
 """
 from __future__ import annotations
 
+import math
+from dataclasses import asdict, dataclass
+
 import numpy as np
 from numba import njit
 
 from layered_swim.body.model import Body
+from layered_swim.config import ConfigError
+from layered_swim.fluid.backend import FluidBackend, FluidWrenches
 from layered_swim.fluid.buoyancy import _buoyancy_wrenches
 from layered_swim.fluid.coefficients import build_coefficient_table
 from layered_swim.fluid.induced_flow import _induced_flow
 from layered_swim.fluid.medium import Medium
 from layered_swim.fluid.plate import _plate_wrenches
+from layered_swim.geometry import quat_to_rows
+from layered_swim.state import BodyState
+
+# Yang eq. 5 ratios (see README, "Calibration"). Along the body the boxes sit in each other's
+# wake, which the per-face model cannot see, so the nearby water moves with the swimmer at r_min
+# of its speed: calibrated so a towed streamlined body matches Narita et al. 2017's passive drag
+# 23.5 v^2 N. Broadside every face meets undisturbed water and the plate model alone gives a
+# realistic bluff-body drag (C_D ~1.2 on ~0.55 m^2), so r_max = 0.
+DEFAULT_R_MIN = 0.68
+DEFAULT_R_MAX = 0.0
+
+
+@dataclass(frozen=True)
+class PlateSettings:
+    """The thin-plate model's own knobs (what the water is lives in ``Medium``)."""
+
+    r_min: float = DEFAULT_R_MIN
+    r_max: float = DEFAULT_R_MAX
+    # Only motion along the body drags water along (the segments sit in each other's wake along
+    # the body axis, not across it), which keeps the legs' weathervane drag that holds the body
+    # level when it pitches or yaws. False: Yang's eq. 5 entrains the whole velocity.
+    axial_induced_flow: bool = True
+    exact_buoyancy: bool = True
+    patches_per_edge: int = 1      # >= 2 resolves a spinning segment's rotational drag (plate.py)
+
+    def __post_init__(self):
+        for name in ("r_min", "r_max"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and 0.0 <= value <= 0.99):
+                raise ConfigError(f"{name} must be a number in [0, 0.99], got {value}")
+        if not 1 <= self.patches_per_edge <= 8:
+            raise ConfigError(f"patches_per_edge must be in 1..8, got {self.patches_per_edge}")
 
 
 @njit(cache=True)
@@ -25,16 +62,16 @@ def _flow_at_swimmer(quat, linvel, mass_fraction, current, r_min, r_max, axial):
     for i in range(linvel.shape[0]):     # a loop: np.dot wants contiguous rows, the state's are views
         for j in range(3):
             com_velocity[j] += mass_fraction[i] * linvel[i, j]
-    x, y, z, w = quat[0, 0], quat[0, 1], quat[0, 2], quat[0, 3]
-    # Pelvis long axis (local z) in world coordinates: third column of its rotation matrix.
-    axis = np.array([2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)])
+    rows = np.empty(9)
+    quat_to_rows(quat[0], rows, False)
+    axis = np.array([rows[2], rows[5], rows[8]])   # the pelvis long axis (local z) in world coordinates
     return current + _induced_flow(com_velocity - current, axis, r_min, r_max, axial)
 
 
 @njit(cache=True)
 def _fluid_wrenches(pos, quat, linvel, angvel, segments, medium, coefficients):
     """``segments`` (n, 8): half extents, ellipsoid semi-axes, mass fraction, volume; ``medium``:
-    the current, then the scalars in the order ThinPlateFluid.__init__ packs them; ``coefficients``
+    the current, then the scalars in the order PlateFluid._pack packs them; ``coefficients``
     (3, k): angles, C_L, C_D. Packed so that the per-step call passes seven arguments, not twenty."""
     half, semi, mass_fraction, volume = segments[:, 0:3], segments[:, 3:6], segments[:, 6], segments[:, 7]
     current = medium[0:3]
@@ -45,39 +82,35 @@ def _fluid_wrenches(pos, quat, linvel, angvel, segments, medium, coefficients):
     force, torque = _plate_wrenches(pos, quat, linvel, angvel, half, flow, rho, eta, surface_z, coefficients[0],
                                     coefficients[1], coefficients[2], int(patches))
     b_force, b_torque = _buoyancy_wrenches(pos, quat, semi, volume, rho, g, surface_z, exact != 0.0)
-    return force + b_force, torque + b_torque, b_force, water
+    return force + b_force, torque + b_torque, flow, b_force
 
 
-class ThinPlateFluid:
-    def __init__(self, body: Body, medium: Medium):
-        self.body = body
-        self.medium = medium
+class PlateFluid(FluidBackend):
+    """Thin plates on every box face, ellipsoid buoyancy and the swimmer-induced flow."""
+
+    name = "plate"
+
+    def __init__(self, body: Body, medium: Medium, gravity_m_s2: float, settings: PlateSettings = PlateSettings()):
+        super().__init__(body, medium, gravity_m_s2)
+        self.plate_settings = settings
         self.table = build_coefficient_table()
-        self._mass_fraction = body.mass_fraction
         self._segments = np.ascontiguousarray(np.column_stack(
-            [body.half_extents_m, body.semi_axes_m, self._mass_fraction, body.volume_m3]), dtype=np.float64)
-        m = medium
-        self._medium = np.array([*m.current_m_s, m.r_min, m.r_max, m.axial_induced_flow, m.rho_kg_m3,
-                                 m.eta_pa_s, m.surface_z_m, abs(m.gravity_m_s2), m.exact_buoyancy,
-                                 m.patches_per_edge], dtype=np.float64)
+            [body.half_extents_m, body.semi_axes_m, body.mass_fraction, body.volume_m3]), dtype=np.float64)
         self._coefficients = np.ascontiguousarray(np.vstack(self.table), dtype=np.float64)
-        # The buoyancy part of the last ``wrenches`` force, for logs that separate it from the
-        # hydrodynamic force (the part a stroke can change).
-        self.buoyancy_force_n = np.zeros((len(body.segment_names), 3))
-        # The water velocity near the swimmer at the last ``wrenches`` (the controller's rules read
-        # it rather than computing it again); the current until the first step.
-        self.flow_m_s = medium.current
+        self.set_medium(medium)
 
-    def flow_at_swimmer(self, pos_m, quat_xyzw, linvel_m_s) -> np.ndarray:
-        """Water velocity near the swimmer: the current plus the flow it drags along. Only motion
-        along the body drags water along by default (``Medium.axial_induced_flow``: the segments
-        sit in each other's wake along the body axis, not across it), which keeps the legs'
-        weathervane drag that holds the body level when it pitches or yaws."""
-        m = self.medium
-        return _flow_at_swimmer(np.asarray(quat_xyzw, dtype=np.float64), np.asarray(linvel_m_s, dtype=np.float64),
-                                self._mass_fraction, m.current, m.r_min, m.r_max, m.axial_induced_flow)
+    def set_medium(self, medium: Medium) -> None:
+        super().set_medium(medium)
+        m, s = medium, self.plate_settings
+        self._medium = np.array([*m.current_m_s, s.r_min, s.r_max, s.axial_induced_flow, m.rho_kg_m3,
+                                 m.eta_pa_s, m.surface_z_m, abs(self.gravity_m_s2), s.exact_buoyancy,
+                                 s.patches_per_edge], dtype=np.float64)
 
-    def wrenches(self, pos_m, quat_xyzw, linvel_m_s, angvel_rad_s) -> tuple[np.ndarray, np.ndarray]:
-        force, torque, self.buoyancy_force_n, self.flow_m_s = _fluid_wrenches(
-            pos_m, quat_xyzw, linvel_m_s, angvel_rad_s, self._segments, self._medium, self._coefficients)
-        return force, torque
+    def settings(self) -> dict:
+        return asdict(self.plate_settings)
+
+    def wrenches(self, state: BodyState) -> FluidWrenches:
+        force, torque, flow, buoyancy = _fluid_wrenches(state.pos_m, state.quat_xyzw, state.linvel_m_s,
+                                                        state.angvel_rad_s, self._segments, self._medium,
+                                                        self._coefficients)
+        return FluidWrenches(force, torque, flow, buoyancy)

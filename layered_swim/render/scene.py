@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from layered_swim.control.pose import quat_rotate
+from layered_swim.geometry import quat_rotate
 
 SKIN = (0.93, 0.72, 0.58)
 SUIT = (0.75, 0.12, 0.16)

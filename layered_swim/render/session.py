@@ -14,12 +14,14 @@ import numpy as np
 from layered_swim.render.scene import Scene
 from layered_swim.control.calibration import CalibrationError
 from layered_swim.control.layered import Layers
-from layered_swim.control.steering import attitude
+from layered_swim.control.steering import attitude_of
 from layered_swim.control.stroke import available_strokes, stroke_path
 from layered_swim.control.targets import MovableTarget, TrajectoryTarget, load_trajectory
+from layered_swim.episode import Episode
 from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S
-from layered_swim.runs import build_swim, make_medium
+from layered_swim.runs import make_medium
 from layered_swim.sim.simulation import SimulationDiverged
+from layered_swim.tasks import FollowTarget
 
 CURRENT_PRESETS_M_S = (("none", (0.0, 0.0, 0.0)), ("0.3 m/s cross", (0.0, 0.3, 0.0)),
                        ("0.5 m/s head-on", (-0.5, 0.0, 0.0)))
@@ -56,7 +58,8 @@ def _presets(presets, given, label) -> tuple[list[Choice], int]:
 
 class ActiveTarget:
     """The target the controller steers to: the scripted trajectory until the user clicks, then
-    the mouse's point. One object for the whole run, so the built controller keeps its reference."""
+    the mouse's point. One object for the session: the controller is built with it and keeps it
+    through every switch."""
 
     def __init__(self, mouse: MovableTarget, trajectory: TrajectoryTarget | None):
         self.mouse, self.trajectory = mouse, trajectory
@@ -86,6 +89,7 @@ class SwimSession:
         self.target = ActiveTarget(self.mouse_target, trajectory_target)
         self.layers = layers
         self.physics_hz = physics_hz
+        self._speed_blend = 1.0 - math.exp(-1.0 / (physics_hz * SPEED_TIME_CONSTANT_S))   # per-step speed smoothing
         self.paused = False
         self.slow_motion = False
         self.message = ""
@@ -94,34 +98,29 @@ class SwimSession:
 
     # --- building ----------------------------------------------------------------------
     def _medium(self):
-        return make_medium(density_kg_m3=self.densities[self.density_index].value).with_(
-            current_m_s=tuple(self.currents[self.current_index].value))
+        return make_medium(density_kg_m3=self.densities[self.density_index].value,
+                           current_m_s=self.currents[self.current_index].value)
 
     def _build(self, stroke: str, position_xy_m, heading_rad: float, use_start_speed: bool) -> None:
-        old = getattr(self, "setup", None)
+        old = getattr(self, "episode", None)
+        task = FollowTarget(self.target, position_xy_m, None if use_start_speed else 0.0, heading_rad)
         try:
             self.cycle_available = True
-            setup = build_swim(stroke, medium=self._medium(), physics_hz=self.physics_hz, target=self.target,
-                               layers=Layers())
+            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=Layers())
         except CalibrationError as err:
             # A stroke without a usable table still swims, with the rules but no steering.
             self.cycle_available = False
             self.message = f"per-cycle steering off: {err}"
-            setup = build_swim(stroke, medium=self._medium(), physics_hz=self.physics_hz, target=self.target,
-                               layers=Layers(cycle=False))
+            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=Layers(cycle=False))
         if old is not None:
-            old.sim.close()
-        self.setup, self.sim, self.stroke = setup, setup.sim, stroke
-        start = setup.stroke.start
-        self.sim.reset(start.posture, start.depth_m, start.speed_m_s if use_start_speed else 0.0,
-                       heading_rad=heading_rad, position_xy_m=position_xy_m)
+            old.close()
+        self.episode, self.sim, self.stroke = episode, episode.sim, stroke
         self._apply_layers()
-        self._mass_fraction = self.sim.body.mass_fraction
         self.trail: deque = deque(maxlen=TRAIL_POINTS)
         self._next_trail_s = 0.0
         self._accumulator_s = 0.0
         self.diverged = False
-        self.speed_m_s = start.speed_m_s if use_start_speed else 0.0
+        self.speed_m_s = float(np.hypot(*self.sim.state.com_vel_m_s[:2]))
         self._rate_samples: deque = deque()
         self.realtime_factor = 0.0
         self.falling_behind = False
@@ -153,11 +152,11 @@ class SwimSession:
 
     def next_current(self) -> None:
         self.current_index = (self.current_index + 1) % len(self.currents)
-        self.sim.set_medium(self._medium())
+        self.sim.fluid.set_medium(self._medium())
 
     def next_density(self) -> None:
         self.density_index = (self.density_index + 1) % len(self.densities)
-        self.sim.set_medium(self._medium())
+        self.sim.fluid.set_medium(self._medium())
 
     def set_target(self, point_xy_m) -> None:
         """Put the mouse target at a point on the water, at the current target depth."""
@@ -204,17 +203,17 @@ class SwimSession:
         """Exactly ``steps`` physics steps (single-stepping, headless rendering)."""
         if self.diverged:
             return
-        blend = 1.0 - math.exp(-1.0 / (self.physics_hz * SPEED_TIME_CONSTANT_S))   # per-step speed smoothing
         try:
-            for _ in range(steps):
-                state = self.sim.step()
-                if self.sim.time_s >= self._next_trail_s:
-                    self._record_trail()
-                velocity = self._mass_fraction @ state.linvel_m_s
-                self.speed_m_s += blend * (math.hypot(velocity[0], velocity[1]) - self.speed_m_s)
+            self.episode.run(steps=steps, observers=[self._after_step])
         except SimulationDiverged as err:
             self.diverged = True
             self.message = f"{err}; press R to reset"
+
+    def _after_step(self, sim) -> None:
+        if sim.time_s >= self._next_trail_s:
+            self._record_trail()
+        velocity = sim.state.com_vel_m_s
+        self.speed_m_s += self._speed_blend * (math.hypot(velocity[0], velocity[1]) - self.speed_m_s)
 
     def _record_trail(self) -> None:
         self.trail.append(self.com_m)
@@ -223,12 +222,11 @@ class SwimSession:
     # --- what the HUD and the renderer read --------------------------------------------
     @property
     def com_m(self) -> np.ndarray:
-        return self._mass_fraction @ self.sim.state.pos_m
+        return self.sim.state.com_m
 
     @property
     def heading_rad(self) -> float:
-        q = self.sim.state.quat_xyzw
-        return attitude(q[0], q[2], self.setup.stroke.start.posture).heading_rad
+        return attitude_of(self.sim.state, self.episode.stroke.start.posture).heading_rad
 
     @property
     def target_m(self) -> np.ndarray:
@@ -261,4 +259,4 @@ class SwimSession:
                      self.sim.fluid_force_n, self.current_m_s)
 
     def close(self) -> None:
-        self.sim.close()
+        self.episode.close()

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from layered_swim.control.pose import _quat_mul
+from layered_swim.geometry import quat_product_into, quat_to_rows
 
 FREE, SPHERICAL, REVOLUTE = 0, 1, 2
 
@@ -96,21 +96,6 @@ class Tree:
         return self._params
 
 
-@njit(cache=True, inline="always")
-def _quat_to_rows(q, out):
-    """Rotation matrix of unit quaternion q (x, y, z, w), row-major into out[0:9]."""
-    x, y, z, w = q[0], q[1], q[2], q[3]
-    out[0] = 1.0 - 2.0 * (y * y + z * z)
-    out[1] = 2.0 * (x * y - z * w)
-    out[2] = 2.0 * (x * z + y * w)
-    out[3] = 2.0 * (x * y + z * w)
-    out[4] = 1.0 - 2.0 * (x * x + z * z)
-    out[5] = 2.0 * (y * z - x * w)
-    out[6] = 2.0 * (x * z - y * w)
-    out[7] = 2.0 * (y * z + x * w)
-    out[8] = 1.0 - 2.0 * (x * x + y * y)
-
-
 @njit(cache=True)
 def forward_kinematics(index, params, q, qd, frames, subspace):
     """Fill ``frames`` (n, FRAME_COLUMNS): per body its centre of mass, orientation (x, y, z, w),
@@ -122,7 +107,7 @@ def forward_kinematics(index, params, q, qd, frames, subspace):
     frames[0, 0:7] = q[0:7]
     frames[0, 7:10] = qd[3:6]
     frames[0, 10:13] = qd[0:3]
-    _quat_to_rows(frames[0, 3:7], frames[0, 13:22])
+    quat_to_rows(frames[0, 3:7], frames[0, 13:22], False)
     frames[0, 22:25] = q[0:3]
     rel = np.empty(4)
     w_rel = np.empty(3)
@@ -142,8 +127,8 @@ def forward_kinematics(index, params, q, qd, frames, subspace):
                 rel[a] = params[i, 6 + a] * s
                 w_rel[a] = params[i, 6 + a] * qd[da]
             rel[3] = c
-        _quat_mul(frames[p, 3:7], rel, frames[i, 3:7])
-        _quat_to_rows(frames[i, 3:7], frames[i, 13:22])
+        quat_product_into(frames[p, 3:7], rel, frames[i, 3:7])
+        quat_to_rows(frames[i, 3:7], frames[i, 13:22], False)
         r = frames[i, 13:22]
         for a in range(3):
             d = r[3 * a] * params[i, 3] + r[3 * a + 1] * params[i, 4] + r[3 * a + 2] * params[i, 5]

@@ -1,24 +1,26 @@
-"""The simulation loop: fixed physics step, controller at a whole divisor of it.
+"""The physics step: fixed physics rate, controller at a whole divisor of it.
 
-One step, one way through: controller (at control rate) -> desired pose -> stable PD;
-body state -> fluid backend -> one wrench per segment -> PyBullet step.
+One step, one way through: body state -> fluid backend -> one wrench per segment; the controller
+(at control rate) reads the state and the water velocity the fluid found -> desired pose ->
+stable PD -> PyBullet step. The episode runner (``layered_swim/episode.py``) is the only loop
+that calls ``step``.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable, Protocol
+from typing import Protocol
 
 import numpy as np
 from numba import njit
 
+from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import Body
 from layered_swim.config import ConfigError
-from layered_swim.control.pose import JointLayout, joint_layout, quat_multiply
-from layered_swim.control.stroke import Stroke
-from layered_swim.fluid.medium import Medium
-from layered_swim.fluid.thin_plate import ThinPlateFluid
-from layered_swim.sim.world import BodyState, World
+from layered_swim.fluid.backend import FluidBackend, FluidWrenches
+from layered_swim.geometry import quat_multiply
+from layered_swim.sim.world import World
+from layered_swim.state import BodyState, JointLayout, Start
 
 PRONE_QUAT_XYZW = (0.0, math.sqrt(0.5), 0.0, math.sqrt(0.5))  # standing frame pitched 90 deg: head +x, face down
 UPRIGHT_QUAT_XYZW = (0.0, 0.0, 0.0, 1.0)
@@ -39,59 +41,43 @@ class SimulationDiverged(RuntimeError):
 
 
 class Controller(Protocol):
-    def desired(self, time_s: float, state: BodyState | None) -> tuple[np.ndarray, np.ndarray]:
-        """Desired pose (rad) and its rate (rad/s) at ``time_s`` (``state`` is None at reset)."""
+    def desired(self, time_s: float, state: BodyState | None,
+                flow_m_s: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        """Desired pose (rad) and its rate (rad/s) at ``time_s``, given the water velocity at each
+        segment (``state`` and ``flow_m_s`` are None at reset)."""
 
     def reset(self) -> None:
         """Forget any state (cycle clock, weights) before a new run."""
-
-
-class StrokeController:
-    """The basic stroke layer alone: the stroke's pose at the current phase."""
-
-    def __init__(self, stroke: Stroke, tempo: float = 1.0):
-        if not (math.isfinite(tempo) and 0.1 <= tempo <= 5.0):
-            raise ConfigError(f"tempo must be between 0.1 and 5, got {tempo}")
-        self.stroke = stroke
-        self.cycles_per_s = tempo / stroke.period_s
-
-    def phase(self, time_s: float) -> float:
-        return time_s * self.cycles_per_s
-
-    def reset(self) -> None:
-        """Stateless: the phase is a function of time."""
-
-    def desired(self, time_s: float, state: BodyState) -> tuple[np.ndarray, np.ndarray]:
-        pose, rate = self.stroke.pose(self.phase(time_s))
-        return pose, rate * self.cycles_per_s
 
 
 @dataclass(frozen=True)
 class SimConfig:
     physics_hz: int = 480
     control_hz: int = 120
+    gravity_m_s2: float = 9.81
 
     def __post_init__(self):
         if self.physics_hz < 120 or self.physics_hz > 5000:
             raise ConfigError(f"physics rate must be in 120..5000 Hz, got {self.physics_hz}")
         if self.control_hz <= 0 or self.physics_hz % self.control_hz:
             raise ConfigError(f"control rate {self.control_hz} Hz must divide the physics rate {self.physics_hz} Hz")
+        if not (math.isfinite(self.gravity_m_s2) and 0.0 <= self.gravity_m_s2 <= 100.0):
+            raise ConfigError(f"gravity must be in 0..100 m/s^2, got {self.gravity_m_s2}")
 
 
 class Simulation:
-    def __init__(self, body: Body, controller: Controller, medium: Medium, config: SimConfig = SimConfig(),
+    def __init__(self, body: Body, controller: Controller, fluid: FluidBackend, config: SimConfig = SimConfig(),
                  layout: JointLayout | None = None, pd_gain_scale: dict[str, float] | None = None):
         self.body = body
         self.layout = layout or joint_layout(body)
         self.controller = controller
-        self.medium = medium
+        self.fluid = fluid
         self.config = config
-        self.fluid = ThinPlateFluid(body, medium)
-        self.world = World(body, self.layout, config.physics_hz, medium.gravity_m_s2, pd_gain_scale)
+        self.world = World(body, self.layout, config.physics_hz, config.gravity_m_s2, pd_gain_scale)
         self.control_every = config.physics_hz // config.control_hz
         self.steps = 0
         self.state: BodyState | None = None
-        self.fluid_force_n = np.zeros((len(body.segment_names), 3))
+        self.fluid_now = _still(len(body.segment_names))   # what the water did in the last step
         # Pushes from outside the water (experiments' impulses), per segment at its centre of
         # mass, world frame; None until the first ``push``, so a plain swim does no extra work.
         self.external_force_n: np.ndarray | None = None
@@ -101,42 +87,41 @@ class Simulation:
     def time_s(self) -> float:
         return self.world.time_s
 
-    def set_medium(self, medium: Medium) -> None:
-        """Change the fluid (density, current) mid-run: the swimmer carries on in the new water."""
-        self.medium = medium
-        self.fluid = ThinPlateFluid(self.body, medium)
+    @property
+    def fluid_force_n(self) -> np.ndarray:
+        return self.fluid_now.force_n
 
-    def reset(self, posture: str = "prone", depth_m: float = 0.1, speed_m_s: float = 0.0,
-              heading_rad: float = 0.0, position_xy_m: tuple[float, float] = (0.0, 0.0)) -> None:
-        base = PRONE_QUAT_XYZW if posture == "prone" else UPRIGHT_QUAT_XYZW
-        yaw = (0.0, 0.0, math.sin(heading_rad / 2), math.cos(heading_rad / 2))
+    def reset(self, start: Start) -> None:
+        base = PRONE_QUAT_XYZW if start.posture == "prone" else UPRIGHT_QUAT_XYZW
+        heading = start.heading_rad
+        yaw = (0.0, 0.0, math.sin(heading / 2), math.cos(heading / 2))
         quat = quat_multiply(np.array(yaw), np.array(base))
-        velocity = (speed_m_s * math.cos(heading_rad), speed_m_s * math.sin(heading_rad), 0.0)
+        velocity = (start.speed_m_s * math.cos(heading), start.speed_m_s * math.sin(heading), 0.0)
         self.controller.reset()
-        pose, _ = self.controller.desired(0.0, None)  # the stroke's pose at phase 0 needs no state
-        self.world.reset((*position_xy_m, -depth_m), quat, pose, velocity)
+        self.fluid.reset()
+        pose, _ = self.controller.desired(0.0, None, None)  # the stroke's pose at phase 0 needs no state
+        self.world.reset((*start.position_xy_m, -start.depth_m), quat, pose, velocity)
         self.steps = 0
         self.external_force_n = None
+        self.fluid_now = _still(len(self.body.segment_names))
         self.state = self.world.read_state()
 
-    def push(self, force_n, segment: int = 0) -> None:
-        """Push ``segment`` (default the pelvis) with ``force_n`` (world frame, at its centre of
-        mass) on every step from now until changed; zero stops it."""
+    def push(self, force_n, segment: str = "pelvis") -> None:
+        """Push ``segment`` with ``force_n`` (world frame, at its centre of mass) on every step
+        from now until changed; zero stops it."""
         if self.external_force_n is None:
             self.external_force_n = np.zeros((len(self.body.segment_names), 3))
-        self.external_force_n[segment] = force_n
+        self.external_force_n[self.body.index(segment)] = force_n
 
     def step(self) -> BodyState:
-        state = self.state if self.state is not None else self.world.read_state()
+        state = self.state
         # The fluid first: the controller's rules read the water velocity it found for this state.
-        force, torque = self.fluid.wrenches(state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s)
-        self.fluid_force_n = force
+        fluid = self.fluid_now = self.fluid.wrenches(state)
         if self.steps % self.control_every == 0:
-            self.desired_pose, self.desired_rate = self.controller.desired(self.world.time_s, state)
+            self.desired_pose, self.desired_rate = self.controller.desired(self.world.time_s, state, fluid.flow_m_s)
             self.world.set_targets(self.desired_pose, self.desired_rate)
-        if self.external_force_n is not None:
-            force = force + self.external_force_n
-        self.world.apply_wrenches(force, torque, state.pos_m)
+        force = fluid.force_n if self.external_force_n is None else fluid.force_n + self.external_force_n
+        self.world.apply_wrenches(force, fluid.torque_nm, state.pos_m)
         self.world.drive()
         self.world.step()
         self.steps += 1
@@ -147,11 +132,11 @@ class Simulation:
                 f"segment velocity); try a higher physics rate or lower PD gains")
         return self.state
 
-    def run(self, seconds: float, every_step: Callable[["Simulation"], None] | None = None) -> None:
-        for _ in range(int(round(seconds * self.config.physics_hz))):
-            self.step()
-            if every_step is not None:
-                every_step(self)
-
     def close(self) -> None:
+        self.fluid.close()
         self.world.close()
+
+
+def _still(n_segments: int) -> FluidWrenches:
+    zeros = np.zeros((n_segments, 3))
+    return FluidWrenches(zeros, zeros, zeros, zeros)

@@ -7,7 +7,7 @@ torque per segment, drives the joints with stable PD and steps.
 The state is read as joint positions and rates (one batched call) and turned into segment poses
 by our own compiled forward kinematics, which also gives the mass matrix that stable PD needs.
 PyBullet's STABLE_PD_CONTROL builds a second model of the body and solves it on every call, more
-than a third of the whole step; ``layered_swim.control.pd`` computes the same torques (tested
+than a third of the whole step; ``layered_swim.sim.pd`` computes the same torques (tested
 against it) and PyBullet only applies them.
 
 The per-step calls go to the ``pybullet`` functions with the World's own client id rather than
@@ -21,7 +21,6 @@ import operator
 import os
 import sys
 import tempfile
-from dataclasses import dataclass
 from itertools import chain
 from pathlib import Path
 
@@ -29,11 +28,11 @@ import numpy as np
 
 from layered_swim.body.model import Body
 from layered_swim.body.urdf import write_urdf
-from layered_swim.control.pd import stable_pd_torques
-from layered_swim.control.pose import JointLayout
 from layered_swim.sim.articulation import (ANGVEL, FRAME_COLUMNS, FREE, LINVEL, POS, QUAT, REVOLUTE, SPHERICAL,
                                            Tree, forward_kinematics, generalized_forces,
                                            mass_matrix_and_bias)
+from layered_swim.sim.pd import stable_pd_torques
+from layered_swim.state import BodyState, JointLayout
 
 
 @contextlib.contextmanager
@@ -62,17 +61,6 @@ with _pybullet_quiet():
 # getJointStatesMultiDof's fields: position, rate.
 _JOINT_POSITION, _JOINT_RATE = operator.itemgetter(0), operator.itemgetter(1)
 _flatten = chain.from_iterable
-
-
-@dataclass
-class BodyState:
-    """Per-segment centre-of-mass state, segment order of the Body (root first)."""
-
-    time_s: float
-    pos_m: np.ndarray          # (n, 3)
-    quat_xyzw: np.ndarray      # (n, 4)
-    linvel_m_s: np.ndarray     # (n, 3)
-    angvel_rad_s: np.ndarray   # (n, 3)
 
 
 def _tree(client, uid: int) -> Tree:
@@ -117,6 +105,7 @@ class World:
         n_joints = c.getNumJoints(self.uid)
         names = {c.getJointInfo(self.uid, j)[12].decode(): j for j in range(n_joints)}
         joint_index = {c.getJointInfo(self.uid, j)[1].decode(): j for j in range(n_joints)}
+        self.segments = body.segments
         self.segment_links = [-1] + [names[s] for s in body.segment_names[1:]]
         for link in [-1, *range(n_joints)]:
             c.setCollisionFilterGroupMask(self.uid, link, 0, 0)   # open water: no contacts at all
@@ -196,7 +185,8 @@ class World:
         forward_kinematics(tree.index, tree.params, self._q, self._qd, self._frames, self._subspace)
         self._fresh = True
         segments = self._frames[self._segment_rows]
-        return BodyState(self.time_s, segments[:, POS], segments[:, QUAT], segments[:, LINVEL], segments[:, ANGVEL])
+        return BodyState(self.time_s, segments[:, POS], segments[:, QUAT], segments[:, LINVEL], segments[:, ANGVEL],
+                         self.segments)
 
     def _ensure_fresh(self) -> None:
         if not self._fresh:

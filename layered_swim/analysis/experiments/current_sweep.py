@@ -7,13 +7,15 @@ from pathlib import Path
 
 import numpy as np
 
-from layered_swim.analysis import plots, swim_benchmark as bench
+from layered_swim.analysis import plots
+from layered_swim.tasks import swim_benchmark as bench
 from layered_swim.analysis.experiments.runner import Outcome
 from layered_swim.analysis.files import write_csv
+from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import load_body
-from layered_swim.control.pose import joint_layout
 from layered_swim.control.stroke import load_stroke
-from layered_swim.tasks import GOAL_METRICS, GOAL_TEMPO, goal_episode
+from layered_swim.runs import GOAL_TEMPO, goal_episode, reach_goal
+from layered_swim.tasks.goal import GOAL_METRICS
 
 NAME = "current-sweep"
 TITLE = "Goal reaching under inflow 0-1.5 m/s in four directions (SWIM 2026, Fig. 6)"
@@ -43,8 +45,11 @@ def configs(quick: bool, seed: int) -> list[dict]:
 
 
 def run(config: dict) -> dict:
-    task = bench.goal_tasks(bench.pool(config["pool"]))[config["goal"]]
-    metrics, _ = goal_episode(task, config["stroke"], tuple(config["current_m_s"]))
+    episode = goal_episode(config["pool"], config["stroke"], tuple(config["current_m_s"]))
+    try:
+        metrics = reach_goal(episode, config["goal"])
+    finally:
+        episode.close()
     return {k: metrics[k] for k in GOAL_METRICS}
 
 

@@ -10,12 +10,14 @@ from matplotlib.ticker import FormatStrFormatter
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
 from layered_swim.analysis.files import write_csv
-from layered_swim.analysis.metrics import SETTLE_S
-from layered_swim.control.layered import Layers
 from layered_swim.control.targets import load_trajectory
+from layered_swim.episode import Episode
 from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S
+from layered_swim.runs import make_medium, swim
 from layered_swim.sim.simulation import SimulationDiverged
-from layered_swim.tasks import TRACK_HZ, swim_toward
+from layered_swim.tasks import FollowTarget
+from layered_swim.tasks.follow import TRACK_HZ
+from layered_swim.tasks.metrics import SETTLE_S
 
 NAME = "density-sweep"
 TITLE = "Sinking depth and tracking error over fluid densities (Yang et al. 2004, Fig. 16; SWIM 2026, 4.4.3)"
@@ -43,11 +45,11 @@ def configs(quick: bool, seed: int) -> list[dict]:
 
 def run(config: dict) -> dict:
     try:
-        track, _ = swim_toward(load_trajectory(config["trajectory"]), config["stroke"], config["seconds"], Layers(),
-                               (0.0, 0.0, 0.0), config["density_kg_m3"])
+        task = FollowTarget(load_trajectory(config["trajectory"]))
+        swim(Episode(config["stroke"], task, medium=make_medium(density_kg_m3=config["density_kg_m3"])), config["seconds"])
     except SimulationDiverged as err:
         return {"diverged": str(err)}
-    a = track.arrays()
+    a = task.track()
     t = a["track_time_s"]
     distance = np.linalg.norm(a["swimmer_m"] - a["target_m"], axis=1)
     settled, second_half = t >= SETTLE_S, t >= t[-1] / 2

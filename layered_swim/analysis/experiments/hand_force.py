@@ -10,7 +10,9 @@ import numpy as np
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
 from layered_swim.analysis.files import write_csv
-from layered_swim.runs import build_swim, record
+from layered_swim.episode import Episode
+from layered_swim.runs import record
+from layered_swim.tasks import FreeSwim
 
 NAME = "hand-force"
 TITLE = "External force on the left hand over one breaststroke cycle from rest (Yang et al. 2004, Fig. 7)"
@@ -28,13 +30,12 @@ def configs(quick: bool, seed: int) -> list[dict]:
 
 
 def run(config: dict) -> dict:
-    setup = build_swim(config["stroke"])
-    sim, start = setup.sim, setup.stroke.start
-    sim.reset(start.posture, start.depth_m, 0.0)          # from rest
-    a = record(sim, config["cycles"] * setup.stroke.period_s, sim.config.physics_hz).arrays()   # every physics step
+    episode = Episode(config["stroke"], FreeSwim(speed_m_s=0.0))          # from rest
+    sim, period_s = episode.sim, episode.stroke.period_s
+    a = record(episode, config["cycles"] * period_s, sim.config.physics_hz).arrays()   # every physics step
     k = sim.body.index(config["segment"])
     return {"time_s": a["time_s"][1:].tolist(), "force_n": a["fluid_force_n"][1:, k].tolist(),
-            "buoyancy_n": a["buoyancy_force_n"][1:, k].tolist(), "period_s": setup.stroke.period_s,
+            "buoyancy_n": a["buoyancy_force_n"][1:, k].tolist(), "period_s": period_s,
             "physics_hz": sim.config.physics_hz, "control_hz": sim.config.control_hz}
 
 

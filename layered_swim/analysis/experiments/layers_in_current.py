@@ -11,7 +11,10 @@ from layered_swim.analysis.experiments.runner import Outcome
 from layered_swim.analysis.files import write_csv
 from layered_swim.control.layered import Layers
 from layered_swim.control.targets import load_trajectory
-from layered_swim.tasks import swim_toward, tracking_metrics
+from layered_swim.episode import Episode
+from layered_swim.fluid.medium import Medium
+from layered_swim.runs import swim
+from layered_swim.tasks import FollowTarget
 
 NAME = "layers-in-current"
 TITLE = "Target tracking in a strong cross current, layer by layer (Yang et al. 2004, Fig. 15)"
@@ -34,11 +37,12 @@ def configs(quick: bool, seed: int) -> list[dict]:
 
 
 def run(config: dict) -> dict:
-    track, _ = swim_toward(load_trajectory(config["trajectory"]), config["stroke"], config["seconds"],
-                           Layers.parse(config["layers"]), config["current_m_s"], None)
-    a = track.arrays()
+    task = FollowTarget(load_trajectory(config["trajectory"]))
+    swim(Episode(config["stroke"], task, medium=Medium(current_m_s=tuple(config["current_m_s"])),
+                 layers=Layers.parse(config["layers"])), config["seconds"])
+    a = task.track()
     return {"time_s": a["track_time_s"].tolist(), "swimmer_m": a["swimmer_m"].tolist(),
-            "target_m": a["target_m"].tolist(), **tracking_metrics(track)}
+            "target_m": a["target_m"].tolist(), **task.metrics()}
 
 
 def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:

@@ -10,7 +10,9 @@ from layered_swim.analysis.experiments.runner import Outcome
 from layered_swim.analysis.files import write_csv
 from layered_swim.control.layered import Layers
 from layered_swim.control.targets import FixedTarget
-from layered_swim.runs import build_swim, record
+from layered_swim.episode import Episode
+from layered_swim.runs import record
+from layered_swim.tasks import FollowTarget
 
 NAME = "palm-rule"
 TITLE = "Forward displacement of the pelvis with and without the palm rule (Yang et al. 2004, Fig. 13)"
@@ -29,10 +31,9 @@ def configs(quick: bool, seed: int) -> list[dict]:
 
 
 def run(config: dict) -> dict:
-    setup = build_swim(config["stroke"], target=FixedTarget((TARGET_AHEAD_M, 0.0, 0.0)),
-                       layers=Layers(cycle=False, palm=config["palm"], reach=False))
-    sim = setup.sim
-    a = record(sim, config["seconds"], LOG_HZ).arrays()
+    episode = Episode(config["stroke"], FollowTarget(FixedTarget((TARGET_AHEAD_M, 0.0, 0.0))),
+                      layers=Layers(cycle=False, palm=config["palm"], reach=False))
+    a = record(episode, config["seconds"], LOG_HZ).arrays()
     return {"time_s": a["time_s"].tolist(), "forward_m": (a["root_pos_m"][:, 0] - a["root_pos_m"][0, 0]).tolist()}
 
 

@@ -11,9 +11,10 @@ from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
 from layered_swim.analysis.files import write_csv
 from layered_swim.body.model import load_body
-from layered_swim.control.layered import Layers
 from layered_swim.control.targets import load_trajectory
-from layered_swim.tasks import swim_toward
+from layered_swim.episode import Episode
+from layered_swim.runs import swim
+from layered_swim.tasks import FollowTarget
 
 NAME = "perturbation"
 TITLE = "Recovery after impulse and random pushes (SWIM 2026, section 4.4.4)"
@@ -49,7 +50,7 @@ def configs(quick: bool, seed: int) -> list[dict]:
 
 
 def push(config: dict, weight_n: float):
-    """The pelvis push of this run as ``on_step(sim)``: sets the force for the next physics step."""
+    """The pelvis push of this run as an episode observer: sets the force for the next physics step."""
     if config["kind"] == "impulse":
         force = config["mg"] * weight_n * np.array(DIRECTIONS[config["direction"]])
         start, end = config["at_s"], config["at_s"] + config["for_s"]
@@ -70,9 +71,10 @@ def push(config: dict, weight_n: float):
 def run(config: dict) -> dict:
     body = load_body()
     weight_n = float(body.total_mass_kg * 9.81)
-    track, _ = swim_toward(load_trajectory(config["trajectory"]), config["stroke"], config["seconds"], Layers(),
-                           (0.0, 0.0, 0.0), None, on_step=push(config, weight_n))
-    a = track.arrays()
+    pusher = push(config, weight_n)
+    episode = swim(Episode(config["stroke"], FollowTarget(load_trajectory(config["trajectory"]))), config["seconds"],
+                   observers=[pusher] if pusher else [])
+    a = episode.task.track()
     distance = np.linalg.norm(a["swimmer_m"] - a["target_m"], axis=1)
     return {"time_s": a["track_time_s"].tolist(), "distance_m": distance.tolist(), "weight_n": weight_n}
 

@@ -12,7 +12,8 @@ from layered_swim.analysis.files import write_csv
 from layered_swim.analysis.stroke_metrics import heading_deg
 from layered_swim.control.layered import Layers, fixed_weights
 from layered_swim.control.steering import FORWARD_LOCAL
-from layered_swim.runs import build_swim, record
+from layered_swim.episode import Episode
+from layered_swim.runs import record
 
 NAME = "turn"
 TITLE = "Yaw over time while treading water with the yaw-left perturbation (Yang et al. 2004, Fig. 11)"
@@ -32,11 +33,11 @@ def configs(quick: bool, seed: int) -> list[dict]:
 
 
 def run(config: dict) -> dict:
-    setup = build_swim(config["stroke"], policy=fixed_weights({config["sequence"]: config["weight"]}, config["basic_cycles"]),
-                       layers=Layers(cycle=True, palm=False, reach=False))
-    sim, period_s = setup.sim, setup.stroke.period_s
-    a = record(sim, (config["basic_cycles"] + config["perturbed_cycles"]) * period_s, LOG_HZ).arrays()
-    yaw = heading_deg(a["root_quat_xyzw"], FORWARD_LOCAL[setup.stroke.start.posture])
+    episode = Episode(config["stroke"], weights=fixed_weights({config["sequence"]: config["weight"]}, config["basic_cycles"]),
+                      layers=Layers(cycle=True, palm=False, reach=False))
+    period_s = episode.stroke.period_s
+    a = record(episode, (config["basic_cycles"] + config["perturbed_cycles"]) * period_s, LOG_HZ).arrays()
+    yaw = heading_deg(a["root_quat_xyzw"], FORWARD_LOCAL[episode.stroke.start.posture])
     return {"time_s": a["time_s"].tolist(), "yaw_deg": (yaw - yaw[0]).tolist(), "period_s": period_s}
 
 

@@ -1,10 +1,11 @@
 """Records a simulation at a fixed log rate and writes ``log.npz`` and ``timeseries.csv``.
 
-Pass the recorder as ``sim.run(..., every_step=recorder)``. It is created right after
-``sim.reset()`` and takes the starting state as sample 0; sample k is the state after physics
+Pass the recorder to ``Episode.run(..., observers=[recorder])``. It is created right after the
+episode's reset and takes the starting state as sample 0; sample k is the state after physics
 step k * (physics_hz / log_hz). The fluid force logged with a state is the one applied during
-the step that led to it (``buoyancy_force_n`` is its buoyancy part); at sample 0 nothing has been
-applied or commanded yet, so the fluid forces and the desired pose are NaN there.
+the step that led to it (``buoyancy_force_n`` is its buoyancy part, NaN for a fluid backend that
+cannot separate it); at sample 0 nothing has been applied or commanded yet, so the fluid forces
+and the desired pose are NaN there.
 
 With ``joint_work=True`` the recorder also integrates the joints' mechanical work every physics
 step (torque times the mean of the joint rates before and after the step, which closes the
@@ -20,7 +21,7 @@ from typing import Mapping
 
 import numpy as np
 
-from layered_swim.analysis.metrics import head_top_height_m
+from layered_swim.tasks.metrics import head_top_height_m
 from layered_swim.config import ConfigError
 
 DEFAULT_LOG_HZ = 60
@@ -61,7 +62,6 @@ class Recorder:
         self.segment_names = body.segment_names
         self.joint_names = joint_position_names(sim.layout)
         self.pose_names = sim.layout.names
-        self._mass_fraction = body.mass_fraction
         self._head = body.index("head")
         self._head_half_z_m = float(body.half_extents_m[self._head, 2])
         self._rows: dict[str, list] = {name: [] for name in ARRAY_NAMES if name != "head_top_m"}
@@ -85,14 +85,16 @@ class Recorder:
         rows["time_s"].append(sim.steps / self._physics_hz)   # exact, unlike a running sum of dt
         rows["root_pos_m"].append(s.pos_m[0])
         rows["root_quat_xyzw"].append(s.quat_xyzw[0])
-        rows["com_pos_m"].append(self._mass_fraction @ s.pos_m)
-        rows["com_vel_m_s"].append(self._mass_fraction @ s.linvel_m_s)
+        rows["com_pos_m"].append(s.com_m)
+        rows["com_vel_m_s"].append(s.com_vel_m_s)
         rows["segment_pos_m"].append(s.pos_m)
         rows["segment_quat_xyzw"].append(s.quat_xyzw)
         rows["joint_positions"].append(sim.world.joint_positions())
         rows["desired_pose_rad"].append(np.full(len(self.pose_names), np.nan) if fresh else sim.desired_pose.copy())
-        rows["fluid_force_n"].append(np.full_like(s.pos_m, np.nan) if fresh else sim.fluid_force_n.copy())
-        rows["buoyancy_force_n"].append(np.full_like(s.pos_m, np.nan) if fresh else sim.fluid.buoyancy_force_n.copy())
+        fluid = sim.fluid_now
+        rows["fluid_force_n"].append(np.full_like(s.pos_m, np.nan) if fresh else fluid.force_n.copy())
+        buoyancy = None if fresh else fluid.buoyancy_force_n
+        rows["buoyancy_force_n"].append(np.full_like(s.pos_m, np.nan) if buoyancy is None else buoyancy.copy())
         if self._work_j is not None:
             rows["joint_work_j"].append(self._work_j)
 

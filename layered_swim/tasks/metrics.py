@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from layered_swim.control.pose import quat_rotate
+from layered_swim.geometry import quat_rotate
 
 SETTLE_S = 5.0
 _UP = np.array([0.0, 0.0, 1.0])

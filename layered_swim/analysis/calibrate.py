@@ -1,0 +1,101 @@
+"""``layered-swim calibrate``: the per-cycle layer's table by preprocessed simulation (Yang 4.3).
+
+For every perturbation sequence of a stroke, simulate the swimmer in still water at a grid of
+weights and tempos (tempo sets the swimming speed): a few basic cycles to settle, then a few
+cycles with the sequence at that weight. The change of the cycle-averaged heading (yaw), body
+pitch or shoulder roll per cycle, minus the unperturbed drift, is the sequence's turn
+(``layered_swim/control/calibration.py`` keeps and reads the table).
+"""
+from __future__ import annotations
+
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+from layered_swim.config import ConfigError
+from layered_swim.control.calibration import SEQUENCE_AXIS, CalibrationTable
+from layered_swim.control.layered import Layers, fixed_weights
+from layered_swim.control.steering import attitude_of, wrap_angle
+from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
+from layered_swim.episode import Episode
+
+AXIS_INDEX = {"yaw": 0, "pitch": 1, "roll": 2}       # columns of a swim's (yaw, pitch, roll) change
+WEIGHTS = (0.0, 0.25, 0.5, 0.75, 1.0)
+TEMPOS = (0.7, 1.0)
+SETTLE_CYCLES = 3
+MEASURE_CYCLES = 2
+
+
+class _CycleAttitude:
+    """Observer: per stroke cycle, the unwrapped heading, pitch and roll at every control step,
+    and the centre of mass once the perturbation is on."""
+
+    def __init__(self, episode: Episode):
+        self.controller, self.posture = episode.controller, episode.stroke.start.posture
+        self.samples: dict[int, list[tuple[float, float, float]]] = {}
+        self.positions: list[np.ndarray] = []
+        self._heading_prev, self._unwrapped = None, 0.0
+
+    def __call__(self, sim) -> None:
+        if sim.steps % sim.control_every:
+            return
+        att = attitude_of(sim.state, self.posture)
+        if self._heading_prev is not None:
+            self._unwrapped += wrap_angle(att.heading_rad - self._heading_prev)
+        self._heading_prev = att.heading_rad
+        cycle = self.controller.cycle
+        self.samples.setdefault(cycle, []).append((self._unwrapped, att.pitch_rad, -att.roll_rad))
+        if cycle >= SETTLE_CYCLES:
+            self.positions.append(sim.state.com_m)
+
+
+def _measure(job: tuple[str, str | None, float, float]) -> tuple:
+    """One calibration swim: (angle change per cycle about the sequence's axis, mean speed, the
+    last cycle's mean roll); with no sequence the change is (yaw, pitch, roll)."""
+    stroke_name, sequence, weight, tempo = job
+    weights = {sequence: weight} if sequence else {}
+    episode = Episode(stroke_name, weights=fixed_weights(weights, SETTLE_CYCLES, tempo),
+                      layers=Layers(cycle=True, palm=False, reach=False))
+    attitude = _CycleAttitude(episode)
+    seconds = (SETTLE_CYCLES + MEASURE_CYCLES) * episode.stroke.period_s / tempo
+    control_hz = episode.sim.config.control_hz
+    try:
+        episode.run(seconds + 0.5 / control_hz, observers=[attitude])
+    finally:
+        episode.close()
+    before = np.mean(attitude.samples[SETTLE_CYCLES - 1], axis=0)
+    after = np.mean(attitude.samples[SETTLE_CYCLES + MEASURE_CYCLES - 1], axis=0)
+    axis = AXIS_INDEX[SEQUENCE_AXIS[sequence][0]] if sequence else 0
+    change = (after - before) / MEASURE_CYCLES
+    track = np.array(attitude.positions)
+    speed = float(np.linalg.norm(track[-1, :2] - track[0, :2]) / (len(track) / control_hz))
+    return (float(change[axis]) if sequence else change.tolist()), speed, float(-after[2])   # roll: left up > 0
+
+
+def calibrate(stroke: Stroke, weights=WEIGHTS, tempos=TEMPOS, workers: int = 2, progress: bool = False) -> CalibrationTable:
+    """Simulate every sequence at every weight and tempo (in parallel) and build the table."""
+    sequences = [name for name in SEQUENCE_NAMES if name in stroke.perturbations]
+    if not sequences:
+        raise ConfigError(f"{stroke.source}: the stroke has no perturbation sequences to calibrate")
+    jobs = [(stroke.source, None, 0.0, tempo) for tempo in tempos]
+    jobs += [(stroke.source, seq, w, tempo) for seq in sequences for tempo in tempos for w in weights if w > 0]
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        results = pool.map(_measure, jobs)
+        if progress:
+            from tqdm import tqdm
+            results = tqdm(results, total=len(jobs), desc=f"calibrating {stroke.name}", unit="swim")
+        results = list(results)
+    baseline = {tempo: results[i][0] for i, tempo in enumerate(tempos)}      # drift with no perturbation
+    speeds = tuple(results[i][1] for i in range(len(tempos)))
+    rolls = tuple(results[i][2] for i in range(len(tempos)))
+    measured = iter(results[len(tempos):])
+    turn_rad = {}
+    for seq in sequences:
+        axis, sign = SEQUENCE_AXIS[seq]
+        k = AXIS_INDEX[axis]
+        rows = []
+        for tempo in tempos:
+            rows.append([0.0] + [sign * (next(measured)[0] - baseline[tempo][k]) for w in weights if w > 0])
+        turn_rad[seq] = np.array(rows)
+    return CalibrationTable(stroke.name, stroke.spec_sha256, tuple(weights), tuple(tempos), speeds, rolls,
+                            turn_rad)

@@ -1,0 +1,133 @@
+"""The one loop: an episode drives the simulation, its task and the controller.
+
+After dm_control's Physics / Task / Environment split and Gymnasium's ``reset(seed)`` / ``step``:
+
+- ``Episode(stroke, task, ...)`` reads the stroke and body files, builds the fluid backend (by
+  name), the controller (from the task's target and the layers) and the simulation, once.
+- ``reset(seed, **options)`` asks the task where to start (it may move its target: a goal task
+  takes ``goal=k``), resets the simulation there without rebuilding anything, and lets the task
+  take its first sample.
+- ``step()`` runs one physics step and lets the task observe it; ``run(seconds)`` is the loop
+  every command, the calibration, the experiments, the app and the bench go through, with
+  ``observers`` (a recorder, a push, the app's trail) called after every step.
+
+Which controller drives the swimmer: ``weights`` (a scripted per-cycle policy) gives the
+layered controller with those weights; otherwise a task without a target gets the basic stroke
+alone, and a task with one gets the layered controller steering toward it (``layers`` says
+which layers are on; the per-cycle layer reads the stroke's calibration table).
+"""
+from __future__ import annotations
+
+import math
+from typing import Callable, Iterable
+
+import numpy as np
+
+from layered_swim.body.layout import joint_layout
+from layered_swim.body.model import load_body
+from layered_swim.config import ConfigError, load
+from layered_swim.control.basic import StrokeController
+from layered_swim.control.calibration import load_table
+from layered_swim.control.layered import Layers, LayeredController, WeightPolicy, fixed_weights
+from layered_swim.control.policy import TargetPolicy, TempoControl
+from layered_swim.control.rules import arm_indices
+from layered_swim.control.steering import SteeringGains
+from layered_swim.control.stroke import Stroke, StrokeSpec, build_stroke, stroke_path
+from layered_swim.control.targets import Target
+from layered_swim.fluid import make_fluid
+from layered_swim.fluid.medium import Medium
+from layered_swim.sim.simulation import SimConfig, Simulation
+from layered_swim.state import BodyState
+from layered_swim.tasks import FreeSwim, Task
+
+Observer = Callable[[Simulation], None]
+
+
+class Episode:
+    def __init__(self, stroke: str, task: Task | None = None, *, medium: Medium = Medium(), backend: str = "plate",
+                 lung_air_l: float | None = None, physics_hz: int = 480, tempo: float = 1.0,
+                 layers: Layers = Layers(), weights: WeightPolicy | None = None,
+                 tempo_control: TempoControl | None = None, seed: int = 0):
+        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+            raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+        self.task = task if task is not None else FreeSwim()
+        self.seed = seed
+        self.body = load_body(lung_air_l=lung_air_l)
+        layout = joint_layout(self.body)
+        path = stroke_path(stroke)
+        self.stroke_spec: StrokeSpec = load(StrokeSpec, path)     # the file as validated, for config.json
+        self.stroke: Stroke = build_stroke(self.stroke_spec, layout, str(path))
+        controller = _controller(self.stroke, self.body, layout, self.task.target, layers, weights, tempo,
+                                 tempo_control)
+        config = SimConfig(physics_hz=physics_hz)
+        fluid = make_fluid(backend, self.body, medium, config.gravity_m_s2)
+        self.sim = Simulation(self.body, controller, fluid, config, layout, self.stroke.pd_gain_scale)
+        self.rng = np.random.default_rng(seed)
+        self.reset(seed)
+
+    @property
+    def controller(self):
+        return self.sim.controller
+
+    @property
+    def time_s(self) -> float:
+        return self.sim.time_s
+
+    def reset(self, seed: int | None = None, **options) -> BodyState:
+        """A new episode: the task picks the start (``options`` go to it), the simulation resets
+        there, the task takes its first sample. ``seed`` restarts the episode's random generator."""
+        if seed is not None:
+            self.rng = np.random.default_rng(seed)
+        start = self.task.reset(self, self.rng, **options)
+        self.sim.reset(start)
+        self.task.observe(self.sim)
+        return self.sim.state
+
+    def step(self) -> BodyState:
+        state = self.sim.step()
+        self.task.observe(self.sim)
+        return state
+
+    def run(self, seconds: float | None = None, *, steps: int | None = None, observers: Iterable[Observer] = (),
+            progress: bool = False) -> None:
+        """Run ``seconds`` of simulated time (or exactly ``steps`` physics steps), calling every
+        observer after every step; ``progress`` shows a bar of simulated seconds."""
+        hz = self.sim.config.physics_hz
+        n = int(round(seconds * hz)) if steps is None else steps
+        observers = list(observers)
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=math.floor(n / hz), desc="simulated seconds", unit="s", leave=False)
+            observers.append(lambda sim: bar.update(1) if sim.steps % hz == 0 else None)
+        try:
+            sim, task = self.sim, self.task
+            for _ in range(n):
+                sim.step()
+                task.observe(sim)
+                for every_step in observers:
+                    every_step(sim)
+        finally:
+            if progress:
+                bar.close()
+
+    def metrics(self) -> dict:
+        return self.task.metrics()
+
+    def close(self) -> None:
+        self.sim.close()
+
+
+def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Layers, weights: WeightPolicy | None,
+                tempo: float, tempo_control: TempoControl | None):
+    if weights is None and target is None:
+        return StrokeController(stroke, tempo)
+    if weights is None:
+        steer = stroke.steering
+        if layers.cycle:
+            pace = tempo_control or TempoControl(min_tempo=steer.min_tempo, glide_within_m=steer.glide_within_m)
+            gains = SteeringGains(steer.yaw_fraction, steer.pitch_fraction, steer.roll_fraction)
+            weights = TargetPolicy(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace)
+        else:
+            weights = fixed_weights({}, tempo=tempo)
+    return LayeredController(stroke, layout, arm_indices(body, layout), weights, layers, target)

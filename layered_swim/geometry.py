@@ -1,0 +1,76 @@
+"""Quaternions and vectors: the one place for rotation maths, numpy and compiled.
+
+Quaternions are (x, y, z, w) throughout, as PyBullet reports them. The compiled routines write
+into caller-owned arrays so the physics step's kernels (forward kinematics, plates, buoyancy,
+ball-joint targets) allocate nothing per call.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product a * b of quaternions (..., 4)."""
+    ax, ay, az, aw = np.moveaxis(a, -1, 0)
+    bx, by, bz, bw = np.moveaxis(b, -1, 0)
+    return np.stack([
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ], axis=-1)
+
+
+def quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rotate vectors v (..., 3) by unit quaternions q (..., 4)."""
+    u, w = q[..., :3], q[..., 3:4]
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
+
+
+def unit_vector(v: np.ndarray) -> np.ndarray:
+    """``v`` scaled to length 1 (zero stays zero)."""
+    norm = float(np.linalg.norm(v))
+    return v / norm if norm > 1e-9 else np.zeros_like(v)
+
+
+@njit(cache=True, inline="always")
+def quat_product_into(a, b, out):
+    """out = a * b (Hamilton product), compiled, no temporaries."""
+    out[0] = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1]
+    out[1] = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0]
+    out[2] = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3]
+    out[3] = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2]
+
+
+@njit(cache=True, inline="always")
+def quat_to_rows(q, out, normalise):
+    """Rotation matrix of quaternion q, row-major into out[0:9] (row r, column c at 3 r + c; the
+    columns are the body axes in world coordinates). With ``normalise`` q need not be unit
+    (the fluid kernels take quaternions from anywhere); without it q must be unit (the
+    kinematics builds its own, a division less per body)."""
+    x, y, z, w = q[0], q[1], q[2], q[3]
+    s = 2.0 / (x * x + y * y + z * z + w * w) if normalise else 2.0
+    out[0] = 1.0 - s * (y * y + z * z)
+    out[1] = s * (x * y - z * w)
+    out[2] = s * (x * z + y * w)
+    out[3] = s * (x * y + z * w)
+    out[4] = 1.0 - s * (x * x + z * z)
+    out[5] = s * (y * z - x * w)
+    out[6] = s * (x * z - y * w)
+    out[7] = s * (y * z + x * w)
+    out[8] = 1.0 - s * (x * x + y * y)
+
+
+@njit(cache=True, inline="always")
+def add_rotated_inverse(q, v0, v1, v2, out):
+    """out += v rotated by the conjugate of unit quaternion q (no temporaries: this runs per joint
+    per control step)."""
+    ux, uy, uz, w = -q[0], -q[1], -q[2], q[3]
+    tx = 2.0 * (uy * v2 - uz * v1)
+    ty = 2.0 * (uz * v0 - ux * v2)
+    tz = 2.0 * (ux * v1 - uy * v0)
+    out[0] += v0 + w * tx + uy * tz - uz * ty
+    out[1] += v1 + w * ty + uz * tx - ux * tz
+    out[2] += v2 + w * tz + ux * ty - uy * tx

@@ -1,0 +1,45 @@
+"""What a task is: what the swimmer is asked to do, and how well it does it.
+
+A task owns its target (None: swim the stroke, go nowhere in particular), says where an episode
+starts (``reset``, which may move the target without anything being rebuilt), observes the
+swim after every physics step (sampling what it scores at its own rate) and turns what it saw
+into metrics. The episode runner (``layered_swim/episode.py``) calls these; nothing else does.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from layered_swim.control.targets import Target
+from layered_swim.state import Start
+
+
+class Task:
+    name = "task"
+    target: Target | None = None
+
+    def reset(self, episode, rng: np.random.Generator, **options) -> Start:
+        """Prepare a new episode of ``episode`` (its stroke, body and controller are built);
+        returns where the swimmer starts. The default: the stroke file's own start."""
+        return episode.stroke.start_state()
+
+    def observe(self, sim) -> None:
+        """Called after reset and after every physics step; cheap unless it is time to sample."""
+
+    def metrics(self) -> dict:
+        return {}
+
+
+def moved_start(start: Start, position_xy_m=None, speed_m_s: float | None = None,
+                heading_rad: float | None = None) -> Start:
+    """``start`` placed at ``position_xy_m``, launched at ``speed_m_s`` and turned to
+    ``heading_rad``, each where given (None: as it was)."""
+    changes = {}
+    if position_xy_m is not None:
+        changes["position_xy_m"] = (float(position_xy_m[0]), float(position_xy_m[1]))
+    if speed_m_s is not None:
+        changes["speed_m_s"] = float(speed_m_s)
+    if heading_rad is not None:
+        changes["heading_rad"] = float(heading_rad)
+    return replace(start, **changes)
