@@ -24,7 +24,7 @@ from layered_swim.control.targets import load_trajectory
 from layered_swim.episode import Episode
 from layered_swim.fluid.medium import Medium, preset
 from layered_swim.recorder import DEFAULT_LOG_HZ, Recorder
-from layered_swim.tasks import FollowTarget, FreeSwim, GoalReaching, swim_benchmark as bench
+from layered_swim.tasks import FollowTarget, FreeSwim, GoalReaching, Task, swim_benchmark as bench
 from layered_swim.tasks.goal import GOAL_METRICS
 
 MAX_SECONDS = 3600.0
@@ -190,14 +190,13 @@ def _dump(spec):
 
 def bench_step(seconds: float = 5.0, physics_hz: int = 480, stroke: str | None = None) -> dict:
     """Microseconds per physics step: (a) the bare PyBullet step of the floating body (no fluid,
-    no PD), (b) the whole loop (state read, fluid, wrenches, PD, step, the task's sampling),
-    through the episode runner. Each is timed BENCH_REPEATS times, alternating so that a burst of
+    no PD), (b) the whole loop (state read, fluid, wrenches, PD, step) through the episode runner. Each is timed BENCH_REPEATS times, alternating so that a burst of
     load elsewhere hits both, and the fastest repeat counts (the usual rule for timing: noise
     never makes code faster)."""
     check_seconds(seconds)
     if stroke is None:
         stroke = "front_crawl" if "front_crawl" in available_strokes() else "rest"
-    episode = Episode(stroke, physics_hz=physics_hz)
+    episode = Episode(stroke, Task(), physics_hz=physics_hz)   # a task that samples nothing: the step alone
     steps = int(round(seconds * physics_hz))
     world = episode.sim.world
 

@@ -39,7 +39,7 @@ class Segments:
         return self.mass_fraction @ per_segment
 
 
-@dataclass
+@dataclass(slots=True)
 class BodyState:
     """Per-segment centre-of-mass state, in the segment order of ``segments`` (root first)."""
 

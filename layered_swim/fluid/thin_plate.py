@@ -110,7 +110,8 @@ class PlateFluid(FluidBackend):
         return asdict(self.plate_settings)
 
     def wrenches(self, state: BodyState) -> FluidWrenches:
-        force, torque, flow, buoyancy = _fluid_wrenches(state.pos_m, state.quat_xyzw, state.linvel_m_s,
-                                                        state.angvel_rad_s, self._segments, self._medium,
-                                                        self._coefficients)
-        return FluidWrenches(force, torque, flow, buoyancy)
+        # The kernel returns the four arrays in FluidWrenches' order; wrapping the tuple as it is
+        # skips the named constructor's argument handling (this runs every physics step).
+        return tuple.__new__(FluidWrenches, _fluid_wrenches(state.pos_m, state.quat_xyzw, state.linvel_m_s,
+                                                            state.angvel_rad_s, self._segments, self._medium,
+                                                            self._coefficients))
