@@ -38,7 +38,7 @@ from layered_swim.fluid import make_fluid
 from layered_swim.fluid.medium import Medium
 from layered_swim.sim.simulation import SimConfig, Simulation
 from layered_swim.state import BodyState
-from layered_swim.tasks import FreeSwim, Task
+from layered_swim.tasks import Task
 
 Observer = Callable[[Simulation], None]
 
@@ -50,7 +50,7 @@ class Episode:
                  tempo_control: TempoControl | None = None, seed: int = 0):
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
             raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
-        self.task = task if task is not None else FreeSwim()
+        self.task = task if task is not None else Task()     # swim the stroke; nothing asked, nothing sampled
         self.seed = seed
         self.body = load_body(lung_air_l=lung_air_l)
         layout = joint_layout(self.body)
@@ -62,7 +62,6 @@ class Episode:
         config = SimConfig(physics_hz=physics_hz)
         fluid = make_fluid(backend, self.body, medium, config.gravity_m_s2)
         self.sim = Simulation(self.body, controller, fluid, config, layout, self.stroke.pd_gain_scale)
-        self.rng = np.random.default_rng(seed)
         self.reset(seed)
 
     @property

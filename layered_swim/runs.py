@@ -24,7 +24,7 @@ from layered_swim.control.targets import load_trajectory
 from layered_swim.episode import Episode
 from layered_swim.fluid.medium import Medium, preset
 from layered_swim.recorder import DEFAULT_LOG_HZ, Recorder
-from layered_swim.tasks import FollowTarget, FreeSwim, GoalReaching, Task, swim_benchmark as bench
+from layered_swim.tasks import FollowTarget, FreeSwim, GoalReaching, swim_benchmark as bench
 from layered_swim.tasks.goal import GOAL_METRICS
 
 MAX_SECONDS = 3600.0
@@ -196,7 +196,7 @@ def bench_step(seconds: float = 5.0, physics_hz: int = 480, stroke: str | None =
     check_seconds(seconds)
     if stroke is None:
         stroke = "front_crawl" if "front_crawl" in available_strokes() else "rest"
-    episode = Episode(stroke, Task(), physics_hz=physics_hz)   # a task that samples nothing: the step alone
+    episode = Episode(stroke, physics_hz=physics_hz)
     steps = int(round(seconds * physics_hz))
     world = episode.sim.world
 

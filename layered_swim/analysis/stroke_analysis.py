@@ -22,7 +22,6 @@ from layered_swim.control.stroke import stroke_path
 from layered_swim.episode import Episode
 from layered_swim.fluid import make_fluid
 from layered_swim.runs import check_seconds, make_medium, record, resolved_config, write_json
-from layered_swim.tasks import FreeSwim
 
 ANALYSIS_LOG_HZ = 120      # ~100 samples per stroke cycle for the profiles
 PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_figure,
@@ -43,7 +42,7 @@ def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | N
 
 def analyze_stroke(config: dict, progress: bool = False) -> dict:
     medium = make_medium(config["fluid"], config["density_kg_m3"], config["current_m_s"])
-    episode = Episode(config["stroke"], FreeSwim(), medium=medium, physics_hz=config["physics_hz"], seed=config["seed"])
+    episode = Episode(config["stroke"], medium=medium, physics_hz=config["physics_hz"], seed=config["seed"])
     sim, stroke = episode.sim, episode.stroke
     recorder = record(episode, config["seconds"], ANALYSIS_LOG_HZ, progress, joint_work=True)
     posture = stroke.start.posture
