@@ -20,6 +20,8 @@ def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog=PROG, description="Swim after the mouse (or a trajectory) in a real-time 3-D window.")
     p.add_argument("--stroke", default="breaststroke", help="stroke name or path to a stroke .yaml (default breaststroke)")
     p.add_argument("--trajectory", help="a trajectory name or .yaml file: show its path and chase its target")
+    p.add_argument("--backend", default="plate",
+                   help="fluid model; the window runs only plate (SPH is ~20x slower than real time: use `layered-swim render --backend sph`)")
     steering_options(p)   # --layers (keys toggle them), --current, --density
     p.add_argument("--size", default="1280x720", metavar="WxH", help="window size in pixels")
     p.add_argument("--capture-dir", default="captures", help="where screenshots and videos go (default captures/)")
@@ -41,6 +43,9 @@ def _open_window(args) -> None:
     from layered_swim.control.layered import Layers
     from layered_swim.render.session import SwimSession
 
+    if args.backend != "plate":
+        raise ConfigError(f"the window runs only --backend plate (got {args.backend!r}): SPH water is about 20x slower "
+                          "than real time; watch it with `layered-swim render TRAJECTORY --backend sph --out sph.mp4`")
     width, height = _size(args.size)
     if args.benchmark_frames is not None and args.benchmark_frames < 2:
         raise ConfigError(f"--benchmark-frames must be at least 2, got {args.benchmark_frames}")

@@ -45,7 +45,9 @@ def _parser() -> argparse.ArgumentParser:
     sub.add_parser("strokes", help="list the available strokes")
 
     validate = sub.add_parser("validate", help="compare the model with measurements")
-    validate.add_argument("what", choices=("drag",), help="drag: towed passive drag vs Narita et al. 2017")
+    validate.add_argument("what", choices=("drag", "sph"),
+                          help="drag: towed passive drag vs Narita et al. 2017; sph: the SPH water against "
+                               "rho g V, the thin plates and Narita (takes minutes)")
     validate.add_argument("--json", action="store_true")
     _backend_option(validate)
 
@@ -60,12 +62,14 @@ def _parser() -> argparse.ArgumentParser:
     follow.add_argument("--seconds", type=float, default=60.0)
     follow.add_argument("--out", help="output folder (default runs/follow-<trajectory>-<timestamp>)")
     follow.add_argument("--json", action="store_true")
+    _backend_option(follow)
 
     goal = sub.add_parser("goal", help="SWIM's goal-reaching benchmark (Pos, Prog, Dev, Roll)")
     goal.add_argument("--pool", choices=("small", "large"), default="small")
     goal.add_argument("--stroke", default="front_crawl")
     steering_options(goal, density=False)
     goal.add_argument("--json", action="store_true")
+    _backend_option(goal, pool=False)
 
     render = sub.add_parser("render", help="draw a run folder or a trajectory swim to a video or PNG frames, no display needed")
     render.add_argument("source", help="a folder written by `run`/`follow --out` (replayed), or a trajectory (swum now)")
@@ -77,6 +81,7 @@ def _parser() -> argparse.ArgumentParser:
     steering_options(render)
     render.add_argument("--forces", action="store_true", help="draw the per-segment fluid-force arrows")
     render.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _backend_option(render)
 
     analyze = sub.add_parser("analyze", help="swim steadily and report per-cycle stroke metrics, plots and a report")
     analyze.add_argument("--stroke", required=True, help="stroke name (see `strokes`) or path to a stroke .yaml")
@@ -102,8 +107,9 @@ def _parser() -> argparse.ArgumentParser:
 
     bench = sub.add_parser("bench", help="time one physics step, bare and through the whole loop")
     bench.add_argument("--json", action="store_true")
-    bench.add_argument("--seconds", type=float, default=5.0, help="simulated seconds per repeat (default 5)")
+    bench.add_argument("--seconds", type=float, help="simulated seconds per repeat (default 5; 0.5 with SPH)")
     bench.add_argument("--physics-hz", type=int, default=480)
+    _backend_option(bench)
     return p
 
 
@@ -116,8 +122,27 @@ def _water_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--physics-hz", type=int, default=480)
 
 
-def _backend_option(command: argparse.ArgumentParser) -> None:
-    command.add_argument("--backend", default="plate", help="fluid model (default plate: thin plates + buoyancy)")
+def _backend_option(command: argparse.ArgumentParser, pool: bool = True) -> None:
+    """--backend and the SPH water's options (used only with --backend sph)."""
+    command.add_argument("--backend", default="plate",
+                         help="fluid model: plate (thin plates + buoyancy, default) or sph (SPlisHSPlasH, the [sph] extra)")
+    sph = command.add_argument_group("SPH water (with --backend sph)")
+    if pool:
+        sph.add_argument("--pool", choices=("small", "large"), default="small",
+                         help="SWIM's pool: small 3 x 1.5 x 0.5 m (default), large 5 x 2 x 0.7 m")
+    sph.add_argument("--particle-radius", type=float, default=0.025, metavar="M", help="default 0.025 m")
+    sph.add_argument("--threads", type=int, metavar="N", help="solver threads (default: every core)")
+    sph.add_argument("--deterministic", action="store_true", help="one solver thread: bit-identical runs")
+
+
+def _fluid_settings(args):
+    """The backend's settings from the command line: None (its defaults) but for SPH."""
+    if args.backend != "sph":
+        return None
+    from layered_swim.runs import sph_settings_for
+
+    return sph_settings_for(args.pool, particle_radius_m=args.particle_radius, threads=args.threads,
+                            deterministic=args.deterministic)
 
 
 def _current_option(command: argparse.ArgumentParser) -> None:
@@ -158,12 +183,23 @@ def _cmd_run(args) -> None:
     out_dir = args.out or default_out_dir(args.stroke)
     result = run_swim(args.stroke, args.seconds, args.lung_air_l, args.density, out_dir, args.seed,
                       args.physics_hz, args.tempo, fluid=args.fluid, progress=not args.json and sys.stderr.isatty(),
-                      backend=args.backend)
+                      backend=args.backend, fluid_settings=_fluid_settings(args))
     if args.json:
         print(json.dumps({**result, "out_dir": str(out_dir)}, allow_nan=False))
         return
-    print(_table([[k, _fmt(v)] for k, v in result.items() if v is not None]))
+    print(_table([[k, _fmt(v)] for k, v in _flat(result).items() if v is not None]))
     print(f"\nwrote summary.json, config.json, log.npz, timeseries.csv to {out_dir}")
+
+
+def _flat(result: dict) -> dict:
+    """Nested summaries (the fluid's report) as ``fluid.key`` rows."""
+    flat = {}
+    for key, value in result.items():
+        if isinstance(value, dict):
+            flat.update({f"{key}.{k}": v for k, v in value.items() if not isinstance(v, (dict, list))})
+        elif not isinstance(value, list):
+            flat[key] = value
+    return flat
 
 
 def _cmd_strokes(args) -> None:
@@ -188,10 +224,16 @@ def _cmd_strokes(args) -> None:
 def _cmd_validate(args) -> None:
     from layered_swim.analysis.drag import REFERENCE_PASSIVE_DRAG_N_S2_M2, towed_drag
     from layered_swim.body.model import load_body
+    from layered_swim.config import ConfigError
     from layered_swim.fluid import make_fluid
     from layered_swim.fluid.medium import Medium
     from layered_swim.sim.simulation import SimConfig
 
+    if args.what == "sph":
+        return _validate_sph(args)
+    if args.backend != "plate":
+        raise ConfigError("validate drag reads a memoryless fluid in one evaluation; "
+                          "the SPH water is validated by `validate sph`")
     rows = towed_drag(make_fluid(args.backend, load_body(), Medium(), SimConfig().gravity_m_s2))
     if args.json:
         print(json.dumps(rows))
@@ -201,10 +243,45 @@ def _cmd_validate(args) -> None:
                  ["speed m/s", "model drag N", f"reference {REFERENCE_PASSIVE_DRAG_N_S2_M2:g} v^2 N", "ratio"]))
 
 
-def _cmd_bench(args) -> None:
-    from layered_swim.runs import bench_step
+def _validate_sph(args) -> None:
+    from layered_swim.analysis.sph_validation import validate_sph
+    from layered_swim.fluid import make_fluid
+    from layered_swim.body.model import load_body
+    from layered_swim.fluid.medium import Medium
 
-    result = bench_step(args.seconds, args.physics_hz)
+    settings = _fluid_settings(argparse.Namespace(**{**vars(args), "backend": "sph"}))
+    make_fluid("sph", load_body(), Medium(), 9.81, settings)       # the extra is installed, the settings valid
+    say = None if args.json else (lambda text: print(f"... {text}", file=sys.stderr))
+    result = validate_sph(settings, progress=say)
+    if args.json:
+        print(json.dumps(result, allow_nan=False))
+        return
+    for label in ("before", "after"):
+        part = result[label]
+        print(f"\n{label} the correction (boxes shrunk by {result['mesh_shrink_radii'] if label == 'after' else 0:g} "
+              f"particle radii per side; r = {result['particle_radius_m']:g} m; means of {1000 * result['window_s']:g} ms windows)")
+        rows = [[name, f"{part[key]['lift_n']:.1f} +- {part[key]['window_sd_n']:.1f}", f"{part[key]['rho_g_v_n']:.1f}",
+                 f"{part[key]['ratio']:.3f}"] for name, key in (("torso box, full", "held_box_full"),
+                                                                ("torso box, half", "held_box_half"))]
+        print(_table(rows, ["held box", "SPH lift N", "rho g V N", "ratio"]))
+        f = part["floating_box"]
+        print(_table([["0.3 x 0.3 x 0.2 m, 500 kg/m3", f"{f['draft_m']:.4f}", f"{f['expected_m']:.4f}", f"{f['ratio']:.3f}"]],
+                     ["floating box", "SPH draft m", "expected m", "ratio"]))
+        print(_table([[f"{r['angle_deg']:g}", f"{r['speed_m_s']:g}", f"{r['drag_n']:.1f} +- {r['window_sd_n']:.1f}",
+                       f"{r['plate_model_n']:.1f}", _fmt(r["ratio"])] for r in part["towed_plate"]],
+                     ["plate deg", "speed m/s", "SPH drag N", "plate model N", "ratio"]))
+        print(_table([[f"{r['speed_m_s']:g}", f"{r['drag_n']:.1f} +- {r['window_sd_n']:.1f}", f"{r['reference_n']:.1f}",
+                       f"{r['ratio']:.3f}"] for r in part["towed_swimmer"]],
+                     ["swimmer m/s", "SPH drag N", "Narita 23.5 v^2 N", "ratio"]))
+
+
+def _cmd_bench(args) -> None:
+    from layered_swim.runs import bench_sph, bench_step
+
+    if args.backend == "sph":
+        result = bench_sph(0.5 if args.seconds is None else args.seconds, _fluid_settings(args))
+    else:
+        result = bench_step(5.0 if args.seconds is None else args.seconds, args.physics_hz)
     if args.json:
         print(json.dumps(result))
         return
@@ -257,7 +334,7 @@ def _cmd_follow(args) -> None:
 
     out = args.out or str(default_out_dir(f"follow-{Path(args.trajectory).stem}"))
     result = follow_run(args.trajectory, args.stroke, Layers.parse(args.layers), _vector(args.current, "--current"),
-                        args.density, args.seconds, out)
+                        args.density, args.seconds, out, args.backend, _fluid_settings(args))
     if args.json:
         print(json.dumps({**result, "out_dir": out}, allow_nan=False))
         return
@@ -272,7 +349,8 @@ def _cmd_goal(args) -> None:
     from layered_swim.runs import goal_run
     from layered_swim.tasks.goal import GOAL_METRICS
 
-    result = goal_run(args.pool, args.stroke, _vector(args.current, "--current"), Layers.parse(args.layers))
+    result = goal_run(args.pool, args.stroke, _vector(args.current, "--current"), Layers.parse(args.layers),
+                      args.backend, _fluid_settings(args))
     if args.json:
         print(json.dumps(result, allow_nan=False))
         return
@@ -287,7 +365,7 @@ def _cmd_render(args) -> None:
 
     result = render(args.source, args.out, args.seconds, args.fps, _size(args.size), args.stroke, Layers.parse(args.layers),
                     _vector(args.current, "--current"), args.density, args.forces,
-                    progress=_progress(args))
+                    progress=_progress(args), backend=args.backend, fluid_settings=_fluid_settings(args))
     if not result["video"] and Path(args.out).suffix.lower() == ".mp4":
         print(f"{PROG}: note: {result['note']}", file=sys.stderr)
     print(f"wrote {result['frames']} frames to {result['out']}")
@@ -382,11 +460,12 @@ def report_errors(prog: str, action) -> int:
     """Run ``action``; bad input or a blown-up simulation is one line on stderr and exit code 2,
     Ctrl-C is 130 (the CLI and app.py both end this way)."""
     from layered_swim.config import ConfigError
+    from layered_swim.fluid.backend import FluidError
     from layered_swim.sim.simulation import SimulationDiverged  # imports PyBullet quietly (sim/world.py)
 
     try:
         action()
-    except (ConfigError, SimulationDiverged, OSError) as err:
+    except (ConfigError, SimulationDiverged, FluidError, OSError) as err:
         print(f"{prog}: error: {_one_line(err)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -45,7 +45,7 @@ Observer = Callable[[Simulation], None]
 
 class Episode:
     def __init__(self, stroke: str, task: Task | None = None, *, medium: Medium = Medium(), backend: str = "plate",
-                 lung_air_l: float | None = None, physics_hz: int = 480, tempo: float = 1.0,
+                 fluid_settings=None, lung_air_l: float | None = None, physics_hz: int = 480, tempo: float = 1.0,
                  layers: Layers = Layers(), weights: WeightPolicy | None = None,
                  tempo_control: TempoControl | None = None, seed: int = 0):
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
@@ -60,7 +60,7 @@ class Episode:
         controller = _controller(self.stroke, self.body, layout, self.task.target, layers, weights, tempo,
                                  tempo_control)
         config = SimConfig(physics_hz=physics_hz)
-        fluid = make_fluid(backend, self.body, medium, config.gravity_m_s2)
+        fluid = make_fluid(backend, self.body, medium, config.gravity_m_s2, fluid_settings)
         self.sim = Simulation(self.body, controller, fluid, config, layout, self.stroke.pd_gain_scale)
         self.reset(seed)
 

@@ -31,6 +31,7 @@ MAX_SECONDS = 3600.0
 MIN_SECONDS = 0.1        # a few log samples, so the metrics have a time span
 BENCH_REPEATS = 5       # bare and loop timed in turn, the fastest of each kept: other load only adds time
 BENCH_WARMUP_S = 0.5     # compiles (or loads) the numba fluid kernels before timing
+SPIKE_BOUND_WEIGHTS = 3.0    # the SPH water's total force on the body (20 ms means) stays under 3 body weights
 GOAL_TEMPO = TempoControl(min_tempo=0.3, near_m=0.2, far_m=1.0)   # slow strokes: the goal line is slow
 
 
@@ -107,7 +108,8 @@ def record(episode: Episode, seconds: float, log_hz: int = DEFAULT_LOG_HZ, progr
 def run_swim(stroke: str, seconds: float = 30.0, lung_air_l: float | None = None,
              density: float | None = None, out_dir: str | Path | None = None, seed: int = 0,
              physics_hz: int = 480, tempo: float = 1.0, fluid: str = "fresh_water",
-             log_hz: int = DEFAULT_LOG_HZ, progress: bool = False, backend: str = "plate") -> dict:
+             log_hz: int = DEFAULT_LOG_HZ, progress: bool = False, backend: str = "plate",
+             fluid_settings=None) -> dict:
     """Run ``stroke`` for ``seconds`` and write summary.json, log.npz, timeseries.csv and
     config.json into ``out_dir`` (default: ``runs/<stroke>-<timestamp>``); returns the summary."""
     out_dir = Path(out_dir) if out_dir is not None else default_out_dir(stroke)
@@ -116,9 +118,10 @@ def run_swim(stroke: str, seconds: float = 30.0, lung_air_l: float | None = None
                  "fluid": fluid, "log_hz": log_hz, "backend": backend}
     check_seconds(seconds)
     episode = Episode(stroke, FreeSwim(sample_hz=log_hz), medium=make_medium(fluid, density), backend=backend,
-                      lung_air_l=lung_air_l, physics_hz=physics_hz, tempo=tempo, seed=seed)
+                      fluid_settings=fluid_settings, lung_air_l=lung_air_l, physics_hz=physics_hz, tempo=tempo,
+                      seed=seed)
     recorder = record(episode, seconds, log_hz, progress)
-    result = episode.metrics()
+    result = {**episode.metrics(), **fluid_report(episode)}
     out_dir.mkdir(parents=True, exist_ok=True)
     recorder.save(out_dir)
     write_json(out_dir / "summary.json", result)
@@ -127,11 +130,13 @@ def run_swim(stroke: str, seconds: float = 30.0, lung_air_l: float | None = None
 
 
 def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = Layers(), current=(0.0, 0.0, 0.0),
-               density: float | None = None, seconds: float = 60.0, out_dir: str | Path | None = None) -> dict:
+               density: float | None = None, seconds: float = 60.0, out_dir: str | Path | None = None,
+               backend: str = "plate", fluid_settings=None) -> dict:
     check_seconds(seconds)
     target = load_trajectory(trajectory)
     episode = Episode(stroke, FollowTarget(target), medium=make_medium(density_kg_m3=density, current_m_s=current),
-                      layers=layers)
+                      layers=layers, backend=backend, fluid_settings=fluid_settings)
+    check_path_in_pool(episode, target, seconds)
     out = Path(out_dir) if out_dir is not None else None
     if out is None:
         swim(episode, seconds)
@@ -139,7 +144,8 @@ def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = L
         out.mkdir(parents=True, exist_ok=True)
         record(episode, seconds).save(out)
     result = {"trajectory": target.name, "stroke": stroke, "layers": layers.describe(),
-              "current_m_s": list(current), "seconds": seconds, **episode.metrics()}
+              "current_m_s": list(current), "seconds": seconds, **episode.metrics(),
+              **fluid_report(episode)}
     if out is not None:
         np.savez_compressed(out / "track.npz", **episode.task.track())
         write_json(out / "summary.json", result)
@@ -147,14 +153,17 @@ def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = L
                                          "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
                                          "density_kg_m3": density, "seconds": seconds,
                                          "stroke_file": episode.stroke.source,
+                                         "fluid_backend": {"name": episode.sim.fluid.name,
+                                                           "settings": episode.sim.fluid.settings()},
                                          "cycles_per_s_at_tempo_1": 1.0 / episode.stroke.period_s})
     return result
 
 
-def goal_episode(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layers = Layers()) -> Episode:
+def goal_episode(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layers = Layers(),
+                 backend: str = "plate", fluid_settings=None) -> Episode:
     """An episode of SWIM's goal reaching in ``pool_name``; ``reset(goal=k)`` picks the goal."""
     return Episode(stroke, GoalReaching(bench.pool(pool_name)), medium=make_medium(current_m_s=current),
-                   layers=layers, tempo_control=GOAL_TEMPO)
+                   layers=layers, tempo_control=GOAL_TEMPO, backend=backend, fluid_settings=fluid_settings)
 
 
 def reach_goal(episode: Episode, goal: int, observers=()) -> dict:
@@ -164,15 +173,54 @@ def reach_goal(episode: Episode, goal: int, observers=()) -> dict:
     return episode.metrics()
 
 
-def goal_run(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layers = Layers()) -> dict:
-    episode = goal_episode(pool_name, stroke, current, layers)
+def goal_run(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layers = Layers(),
+             backend: str = "plate", fluid_settings=None) -> dict:
+    episode = goal_episode(pool_name, stroke, current, layers, backend, fluid_settings)
+    per_goal = []
     try:
-        per_goal = [reach_goal(episode, k) for k in range(len(episode.task.goals))]
+        for k in range(len(episode.task.goals)):
+            per_goal.append({**reach_goal(episode, k), **fluid_report(episode)})
     finally:
         episode.close()
     mean = {k: float(np.mean([g[k] for g in per_goal])) for k in GOAL_METRICS}
     return {"pool": pool_name, "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
-            **mean, "goals": per_goal, "swim_published": bench.SWIM_PUBLISHED.get(pool_name)}
+            "fluid_backend": backend, **mean, "goals": per_goal, "swim_published": bench.SWIM_PUBLISHED.get(pool_name)}
+
+
+def sph_settings_for(pool_name: str, **options):
+    """SPH settings whose pool is SWIM's pool ``pool_name`` (length, width, water depth)."""
+    from layered_swim.fluid.sph import SphSettings
+
+    pool = bench.pool(pool_name)
+    return SphSettings(pool_size_m=(pool.length_m, pool.width_m, pool.depth_m), **options)
+
+
+def fluid_report(episode: Episode) -> dict:
+    """What the fluid model says about the swim (the SPH pool, settle, timing; nothing for the
+    plates), with its peak total force on the body after the settle against the stated bound."""
+    report = episode.sim.fluid.report()
+    if not report:
+        return {}
+    if "peak_total_force_n" in report:
+        bound = SPIKE_BOUND_WEIGHTS * episode.body.total_mass_kg * episode.sim.config.gravity_m_s2
+        report.update(force_bound_n=bound, within_force_bound=report["peak_total_force_n"] <= bound)
+    return {"fluid": report}
+
+
+def check_path_in_pool(episode: Episode, target, seconds: float) -> None:
+    """A bounded fluid must hold the target's path: refuse in one line before swimming."""
+    domain = episode.sim.fluid.domain_xy_m(episode.sim.state)
+    if domain is None:
+        return
+    lo, hi = domain
+    times = np.linspace(0.0, seconds, max(2, int(seconds * 10)))
+    path = np.array([target.position(t)[:2] for t in times])
+    outside = ~np.all((path > lo) & (path < hi), axis=1)
+    if outside.any():
+        t = times[int(np.argmax(outside))]
+        raise ConfigError(f"the target leaves the {hi[0] - lo[0]:g} x {hi[1] - lo[1]:g} m SPH pool at t = {t:.1f} s "
+                          f"(at x = {path[outside][0][0]:.2f}, y = {path[outside][0][1]:.2f} m); "
+                          "use --pool large, fewer --seconds or --backend plate")
 
 
 def check_seconds(seconds: float) -> None:
@@ -186,6 +234,32 @@ def write_json(path: Path, data) -> None:
 
 def _dump(spec):
     return spec.model_dump(mode="json") if spec is not None else None
+
+
+def bench_sph(seconds: float = 0.5, settings=None, stroke: str = "breaststroke") -> dict:
+    """The SPH backend's speed: particles, milliseconds per physics step, wall seconds per
+    simulated second, and the share of the step spent outside SPlisHSPlasH's own calls (our
+    coupling: PyBullet, the controller, the worker's messages, placing boxes and reading forces).
+    The settle is built and timed apart, before the timed swim."""
+    check_seconds(seconds)
+    episode = Episode(stroke, backend="sph", fluid_settings=settings)
+    fluid = episode.sim.fluid
+    try:
+        episode.run(steps=1)                    # builds the pool and settles it
+        solver_before, steps = fluid.solver_s, int(round(seconds * episode.sim.config.physics_hz))
+        t0 = time.perf_counter()
+        episode.run(steps=steps)
+        wall = time.perf_counter() - t0
+        solver = fluid.solver_s - solver_before
+        report = fluid.report()
+    finally:
+        episode.close()
+    return {"stroke": stroke, "fluid_particles": report["fluid_particles"],
+            "boundary_particles": report["boundary_particles"], "particle_radius_m": fluid.sph_settings.particle_radius_m,
+            "threads": fluid.sph_settings.solver_threads, "steps": steps, "ms_per_step": 1e3 * wall / steps,
+            "wall_s_per_simulated_s": wall / seconds, "solver_ms_per_step": 1e3 * solver / steps,
+            "outside_solver_share": 1.0 - solver / wall, "settle_wall_s": report["settle_wall_s"],
+            "build_s": report["build_s"]}
 
 
 def bench_step(seconds: float = 5.0, physics_hz: int = 480, stroke: str | None = None) -> dict:

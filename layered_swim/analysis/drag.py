@@ -25,9 +25,8 @@ GLIDE_DEPTH_M = 0.2                          # pelvis centre below the surface: 
 SPEEDS_M_S = (0.5, 1.0, 1.5, 2.0, 2.5)
 
 
-def towed_drag(fluid: FluidBackend, speeds_m_s=SPEEDS_M_S) -> list[dict]:
-    """Drag of ``fluid``'s body towed through its water at each speed."""
-    body = fluid.body
+def glide_state(body) -> BodyState:
+    """The body at rest in the streamlined glide, prone, pelvis GLIDE_DEPTH_M under the surface."""
     layout = joint_layout(body)
     pose = layout.zeros()
     for name, deg in GLIDE_POSE_DEG.items():
@@ -35,9 +34,16 @@ def towed_drag(fluid: FluidBackend, speeds_m_s=SPEEDS_M_S) -> list[dict]:
     world = World(body, layout, physics_hz=480)
     try:
         world.reset((0.0, 0.0, -GLIDE_DEPTH_M), PRONE_QUAT_XYZW, pose)
-        glide = world.read_state()
+        return world.read_state()
     finally:
         world.close()
+
+
+def towed_drag(fluid: FluidBackend, speeds_m_s=SPEEDS_M_S) -> list[dict]:
+    """Drag of ``fluid``'s body towed through its water at each speed (one evaluation, no time:
+    a model without memory, like the plates)."""
+    body = fluid.body
+    glide = glide_state(body)
     rows = []
     for v in speeds_m_s:
         velocity = np.tile([v, 0.0, 0.0], (len(body.segment_names), 1))

@@ -20,6 +20,10 @@ from layered_swim.fluid.medium import Medium
 from layered_swim.state import BodyState
 
 
+class FluidError(RuntimeError):
+    """The fluid model failed (a solver process died, the water blew up, the swimmer left it)."""
+
+
 class FluidWrenches(NamedTuple):
     """What the water does to the body in one step, per segment, world frame."""
 
@@ -50,6 +54,19 @@ class FluidBackend:
         """The model's own settings, JSON-able, for the run's resolved config."""
         return {}
 
+    def report(self) -> dict:
+        """What the model says about the swim so far, JSON-able, for the run's summary."""
+        return {}
+
+    def domain_xy_m(self, state: BodyState) -> tuple[np.ndarray, np.ndarray] | None:
+        """The horizontal extent (lower and upper corner) of the water for a swim starting at
+        ``state``; None where the water has no walls (the plates)."""
+        return None
+
+    def particles(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Water to draw: particle positions (k, 3) and speeds (k,); None where the model has none."""
+        return None
+
     def reset(self) -> None:
         """Forget any state of the water before a new episode (the plates keep none)."""
 
@@ -57,18 +74,19 @@ class FluidBackend:
         """Release what the backend holds (processes, files)."""
 
 
-BackendFactory = Callable[[Body, Medium, float], FluidBackend]
+BackendFactory = Callable[..., FluidBackend]
 BACKENDS: dict[str, BackendFactory] = {}
 
 
 def register_backend(name: str, factory: BackendFactory) -> None:
-    """Make ``factory(body, medium, gravity_m_s2)`` available as ``--backend name``."""
+    """Make ``factory(body, medium, gravity_m_s2[, settings])`` available as ``--backend name``
+    (``settings``: the backend's own settings object, passed only when the caller gives one)."""
     BACKENDS[name] = factory
 
 
-def make_fluid(name: str, body: Body, medium: Medium, gravity_m_s2: float) -> FluidBackend:
+def make_fluid(name: str, body: Body, medium: Medium, gravity_m_s2: float, settings=None) -> FluidBackend:
     try:
         factory = BACKENDS[name]
     except KeyError:
         raise ConfigError(f"unknown fluid backend {name!r} (available: {', '.join(sorted(BACKENDS))})") from None
-    return factory(body, medium, gravity_m_s2)
+    return factory(body, medium, gravity_m_s2) if settings is None else factory(body, medium, gravity_m_s2, settings)

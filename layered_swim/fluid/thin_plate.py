@@ -90,9 +90,9 @@ class PlateFluid(FluidBackend):
 
     name = "plate"
 
-    def __init__(self, body: Body, medium: Medium, gravity_m_s2: float, settings: PlateSettings = PlateSettings()):
+    def __init__(self, body: Body, medium: Medium, gravity_m_s2: float, settings: PlateSettings | None = None):
         super().__init__(body, medium, gravity_m_s2)
-        self.plate_settings = settings
+        self.plate_settings = settings or PlateSettings()
         self.table = build_coefficient_table()
         self._segments = np.ascontiguousarray(np.column_stack(
             [body.half_extents_m, body.semi_axes_m, body.mass_fraction, body.volume_m3]), dtype=np.float64)

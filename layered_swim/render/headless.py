@@ -14,6 +14,7 @@ from layered_swim.render.camera import OrbitCamera
 from layered_swim.render.frames import FrameWriter
 from layered_swim.config import ConfigError
 from layered_swim.control.layered import Layers
+from layered_swim.runs import check_path_in_pool
 from layered_swim.sim.simulation import SimulationDiverged
 
 MAX_FRAMES = 20_000
@@ -27,13 +28,13 @@ def frame_steps(frame: int, physics_hz: int, fps: float) -> int:
 def render(source: str, out: str | Path, seconds: float | None = None, fps: float = 30.0,
            size_px: tuple[int, int] = (960, 540), stroke: str = "breaststroke", layers: Layers = Layers(),
            current_m_s=(0.0, 0.0, 0.0), density_kg_m3: float | None = None, show_forces: bool = False,
-           progress: bool = False) -> dict:
+           progress: bool = False, backend: str = "plate", fluid_settings=None) -> dict:
     if not (math.isfinite(fps) and 1 <= fps <= 120):
         raise ConfigError(f"--fps must be between 1 and 120, got {fps}")
     width, height = size_px
     if seconds is not None and not (math.isfinite(seconds) and 0 < seconds <= 3600):
         raise ConfigError(f"--seconds must be in (0, 3600], got {seconds}")
-    frames = _frames(source, seconds, fps, stroke, layers, current_m_s, density_kg_m3)
+    frames = _frames(source, seconds, fps, stroke, layers, current_m_s, density_kg_m3, backend, fluid_settings)
     os.environ["PYGLET_HEADLESS"] = "1"
     import pyglet
     pyglet.options["headless"] = True
@@ -61,7 +62,7 @@ def render(source: str, out: str | Path, seconds: float | None = None, fps: floa
     return {"out": str(path), "frames": writer.frames, "fps": fps, "video": writer.is_video, "note": writer.note}
 
 
-def _frames(source, seconds, fps, stroke, layers, current_m_s, density_kg_m3):
+def _frames(source, seconds, fps, stroke, layers, current_m_s, density_kg_m3, backend, fluid_settings):
     """Yields (segment names, frame count) first, then one Scene per frame."""
     path = Path(source)
     if path.is_dir():
@@ -79,9 +80,12 @@ def _frames(source, seconds, fps, stroke, layers, current_m_s, density_kg_m3):
         trajectory_path(source)
     except ConfigError as err:
         raise ConfigError(f"{source}: neither a run folder nor a trajectory ({err})") from None
-    session = SwimSession(stroke, layers, current_m_s, density_kg_m3, trajectory=source)
-    total = _count(20.0 if seconds is None else seconds, fps)
+    session = SwimSession(stroke, layers, current_m_s, density_kg_m3, trajectory=source, backend=backend,
+                          fluid_settings=fluid_settings)
+    duration_s = 20.0 if seconds is None else seconds
+    total = _count(duration_s, fps)
     try:
+        check_path_in_pool(session.episode, session.target, duration_s)
         yield session.sim.body.segment_names, total
         for k in range(total):
             yield session.scene()

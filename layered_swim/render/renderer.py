@@ -61,6 +61,7 @@ class Renderer:
         self._water.normal[:] = [0.0, 0.0, 1.0] * 6
         self._grid = _Lines(self._list(MAX_LINE_VERTICES, gl.GL_LINES, np.zeros((MAX_LINE_VERTICES, 4))))
         self._guides = _Lines(self._list(MAX_LINE_VERTICES, gl.GL_LINES, np.zeros((MAX_LINE_VERTICES, 4))))
+        self._particles = None        # GL_POINTS, sized on the first frame that has water particles
 
     def _list(self, count: int, mode: int, colors: np.ndarray):
         return self.program.vertex_list(count, mode, position=("f", np.zeros(3 * count).tolist()),
@@ -103,6 +104,9 @@ class Renderer:
         gl.glDepthMask(gl.GL_TRUE)
         gl.glColorMask(gl.GL_TRUE, gl.GL_TRUE, gl.GL_TRUE, gl.GL_TRUE)
 
+        if scene.particles_m is not None:
+            self._draw_particles(scene.particles_m, scene.particle_speed_m_s)
+
         # Guides stay vivid whatever their depth: the target, its path, the trail, the arrows.
         if scene.target_m is not None:
             p["lit"] = 1.0
@@ -132,9 +136,29 @@ class Renderer:
             groups.append((sc.arrow_lines(start, sc.CURRENT_SCALE_M_PER_M_S * scene.current_m_s), sc.CURRENT_COLOR))
         return groups
 
+    def _draw_particles(self, positions_m: np.ndarray, speeds_m_s: np.ndarray) -> None:
+        """The SPH water as points coloured by speed (still blue to fast white), unlit."""
+        count = len(positions_m)
+        if self._particles is None or self._particles[1] < count:
+            if self._particles is not None:
+                self._particles[0].delete()
+            self._particles = (self._list(count, gl.GL_POINTS, np.zeros((count, 4))), count)
+        points, capacity = self._particles
+        positions = np.zeros((capacity, 3))
+        positions[:count] = positions_m
+        colors = np.zeros((capacity, 4))
+        colors[:count] = sc.speed_colors(speeds_m_s)
+        points.position[:] = positions.reshape(-1).tolist()
+        points.color[:] = colors.reshape(-1).tolist()
+        self.program["lit"] = 0.0
+        gl.glPointSize(3.0)
+        points.draw(gl.GL_POINTS)
+
     def delete(self) -> None:
         for vertex_list in (self._boxes, self._marker, self._water, self._grid.vertices, self._guides.vertices):
             vertex_list.delete()
+        if self._particles is not None:
+            self._particles[0].delete()
 
 
 class _Lines:

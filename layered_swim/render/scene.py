@@ -61,6 +61,8 @@ class Scene:
     trail_m: np.ndarray | None = None # the swimmer's recent track
     forces_n: np.ndarray | None = None
     current_m_s: np.ndarray | None = None
+    particles_m: np.ndarray | None = None        # (k, 3) water particles (the SPH backend)
+    particle_speed_m_s: np.ndarray | None = None  # (k,)
 
     @property
     def centre_of_segments_m(self) -> np.ndarray:
@@ -130,3 +132,14 @@ def grid_lines(centre_m: np.ndarray, z_m: float = -GRID_DEPTH_M, spacing_m: floa
     along_x = [((cx - extent, cy + o, z_m), (cx + extent, cy + o, z_m)) for o in offsets]
     along_y = [((cx + o, cy - extent, z_m), (cx + o, cy + extent, z_m)) for o in offsets]
     return np.array(along_x + along_y, dtype=float).reshape(-1, 3)
+
+
+SPEED_COLOR_MAX_M_S = 1.5     # water at this speed or faster is drawn white
+
+
+def speed_colors(speeds_m_s: np.ndarray) -> np.ndarray:
+    """RGBA per water particle: deep blue at rest through cyan to white at SPEED_COLOR_MAX_M_S."""
+    t = np.clip(np.asarray(speeds_m_s, dtype=float) / SPEED_COLOR_MAX_M_S, 0.0, 1.0)[:, None]
+    still, middle, fast = np.array([0.05, 0.2, 0.6]), np.array([0.1, 0.75, 0.95]), np.array([1.0, 1.0, 1.0])
+    rgb = np.where(t < 0.5, still + (middle - still) * (2 * t), middle + (fast - middle) * (2 * t - 1))
+    return np.column_stack([rgb, np.ones(len(rgb))])

@@ -74,7 +74,8 @@ class ActiveTarget:
 
 class SwimSession:
     def __init__(self, stroke: str = "breaststroke", layers: Layers = Layers(), current_m_s=(0.0, 0.0, 0.0),
-                 density_kg_m3: float | None = None, trajectory: str | None = None, physics_hz: int = 480):
+                 density_kg_m3: float | None = None, trajectory: str | None = None, physics_hz: int = 480,
+                 backend: str = "plate", fluid_settings=None):
         self.strokes = available_strokes()
         stroke_path(stroke)                          # unknown stroke: one-line error before anything opens
         if stroke not in self.strokes:
@@ -89,6 +90,7 @@ class SwimSession:
         self.target = ActiveTarget(self.mouse_target, trajectory_target)
         self.layers = layers
         self.physics_hz = physics_hz
+        self.backend, self.fluid_settings = backend, fluid_settings
         self._speed_blend = 1.0 - math.exp(-1.0 / (physics_hz * SPEED_TIME_CONSTANT_S))   # per-step speed smoothing
         self.paused = False
         self.slow_motion = False
@@ -106,12 +108,14 @@ class SwimSession:
         task = FollowTarget(self.target, position_xy_m, None if use_start_speed else 0.0, heading_rad)
         try:
             self.cycle_available = True
-            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=Layers())
+            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=Layers(),
+                              backend=self.backend, fluid_settings=self.fluid_settings)
         except CalibrationError as err:
             # A stroke without a usable table still swims, with the rules but no steering.
             self.cycle_available = False
             self.message = f"per-cycle steering off: {err}"
-            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=Layers(cycle=False))
+            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=Layers(cycle=False),
+                              backend=self.backend, fluid_settings=self.fluid_settings)
         if old is not None:
             old.close()
         self.episode, self.sim, self.stroke = episode, episode.sim, stroke
@@ -254,9 +258,10 @@ class SwimSession:
 
     def scene(self) -> Scene:
         state, body = self.sim.state, self.sim.body
+        water = self.sim.fluid.particles()
         return Scene(body.segment_names, body.half_extents_m, state.pos_m, state.quat_xyzw, self.target_m,
                      self.trajectory_path_m if self.target.scripted else None, np.array(self.trail),
-                     self.sim.fluid_force_n, self.current_m_s)
+                     self.sim.fluid_force_n, self.current_m_s, *(water or (None, None)))
 
     def close(self) -> None:
         self.episode.close()

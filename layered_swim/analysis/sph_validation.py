@@ -1,0 +1,183 @@
+"""``layered-swim validate sph``: the SPH water against what it must reproduce.
+
+- Buoyancy of a held torso-sized box, fully and half submerged, against rho g V.
+- A flat plate towed at 0.5-1.5 m/s at 0, 30, 60 and 90 deg against the thin-plate model
+  (the project's own plate kernel on the same box at the same velocity).
+- The draft of a free-floating box (density 500 kg/m^3: half its height under water).
+- The towed swimmer's passive drag against Narita et al. 2017's 23.5 v^2 N.
+
+Each case runs without and with the boundary correction (boxes shrunk by ``mesh_shrink_radii``
+particle radii per side: SPH leaves a fluid-free skin about one radius thick on every wall, so
+bodies come out too big). Per-step forces are noisy (sd ~15 %): every figure is the mean of
+20 ms windows, reported with the windows' standard deviation.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from layered_swim.analysis.drag import REFERENCE_PASSIVE_DRAG_N_S2_M2, glide_state
+from layered_swim.body.model import load_body
+from layered_swim.fluid.coefficients import build_coefficient_table
+from layered_swim.fluid.medium import Medium
+from layered_swim.fluid.plate import _plate_wrenches
+from layered_swim.fluid.sph import SphSettings
+from layered_swim.fluid.sph.backend import DAMPED_SHARE, DAMPING_PER_STEP, HEADROOM_M
+from layered_swim.fluid.sph.worker import SphWorker
+
+WINDOW_S = 0.02
+TORSO_HALF_M = np.array([0.15, 0.175, 0.275])       # 0.30 x 0.35 x 0.55 m: pelvis to shoulders
+PLATE_HALF_M = np.array([0.15, 0.15, 0.025])        # 0.30 x 0.30 m, thin along its local z
+FLOAT_HALF_M = np.array([0.15, 0.15, 0.10])         # 0.30 x 0.30 x 0.20 m at 500 kg/m^3: 0.10 m draft
+FLOAT_DENSITY_KG_M3 = 500.0
+TOW_SPEEDS_M_S = (0.5, 1.0, 1.5)
+TOW_ANGLES_DEG = (0.0, 30.0, 60.0, 90.0)
+SWIMMER_SPEEDS_M_S = (1.0, 1.5)
+IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
+
+
+class Tank:
+    """A rectangular tank of SPH water with boxes in it, driven step by step (no PyBullet)."""
+
+    def __init__(self, settings: SphSettings, medium: Medium, size_m, half_m, pos_m, quat_xyzw, shrink: bool,
+                 gravity_m_s2: float = 9.81):
+        r = settings.particle_radius_m
+        half = np.atleast_2d(half_m)
+        self.half_m = np.maximum(half - settings.mesh_shrink_radii * r, half / 2) if shrink else half
+        self.dt = settings.time_step_s
+        length, width, depth = size_m
+        self.worker = SphWorker(settings.solver_threads)
+        viscosity = medium.eta_pa_s / medium.rho_kg_m3
+        self.startup = self.worker.request("start", {
+            "scene": {"pool_min_m": np.array([-length / 2, -width / 2, -depth]),
+                      "pool_max_m": np.array([length / 2, width / 2, HEADROOM_M]),
+                      "water_top_z_m": 0.0, "particle_radius_m": r, "time_step_s": self.dt,
+                      "density_kg_m3": medium.rho_kg_m3, "viscosity_m2_s": viscosity, "gravity_m_s2": gravity_m_s2,
+                      "boxes_half_m": self.half_m, "box_centres_m": np.atleast_2d(pos_m)},
+            "viscosity_m2_s": viscosity, "pos_m": np.atleast_2d(pos_m), "quat_xyzw": np.atleast_2d(quat_xyzw),
+            "settle_s": settings.settle_s, "damped_share": DAMPED_SHARE, "damping_per_step": DAMPING_PER_STEP,
+        })
+
+    def step(self, pos_m, quat_xyzw, linvel_m_s) -> np.ndarray:
+        """One step with the boxes at this pose and velocity; the total force on them (3,)."""
+        pos, quat = np.atleast_2d(pos_m), np.atleast_2d(quat_xyzw)
+        force, _, _, _, max_speed = self.worker.request("step", (pos, quat, np.atleast_2d(linvel_m_s),
+                                                                 np.zeros_like(pos)))
+        if not max_speed < 30.0:
+            raise RuntimeError(f"SPH water blew up (a particle at {max_speed:.3g} m/s)")
+        return force.sum(axis=0)
+
+    def close(self) -> None:
+        self.worker.close()
+
+
+def windowed(values: np.ndarray, dt: float) -> tuple[float, float]:
+    """Mean and standard deviation of WINDOW_S means of a per-step series."""
+    per = max(1, int(round(WINDOW_S / dt)))
+    usable = len(values) // per * per
+    means = np.asarray(values[:usable]).reshape(-1, per).mean(axis=1)
+    return float(means.mean()), float(means.std())
+
+
+def held_box(settings: SphSettings, medium: Medium, centre_z_m: float, shrink: bool, seconds: float = 0.3) -> dict:
+    """Vertical force on the torso box held still with its centre at ``centre_z_m``."""
+    tank = Tank(settings, medium, (1.4, 1.2, 0.9), TORSO_HALF_M, [0.0, 0.0, centre_z_m], IDENTITY, shrink)
+    try:
+        lift = np.array([tank.step([0.0, 0.0, centre_z_m], IDENTITY, np.zeros(3))[2]
+                         for _ in range(int(round(seconds / tank.dt)))])
+    finally:
+        tank.close()
+    submerged = np.clip(-(centre_z_m - TORSO_HALF_M[2]), 0.0, 2 * TORSO_HALF_M[2])
+    expected = medium.rho_kg_m3 * 9.81 * 4 * TORSO_HALF_M[0] * TORSO_HALF_M[1] * submerged
+    mean, sd = windowed(lift, tank.dt)
+    return {"lift_n": mean, "window_sd_n": sd, "rho_g_v_n": expected, "ratio": mean / expected}
+
+
+def plate_model_drag(medium: Medium, speed_m_s: float, quat_xyzw: np.ndarray) -> float:
+    """The thin-plate model's force against the tow on the same box (no buoyancy, still water)."""
+    angles, cl, cd = build_coefficient_table()
+    force, _ = _plate_wrenches(np.zeros((1, 3)), quat_xyzw[None], np.array([[speed_m_s, 0.0, 0.0]]), np.zeros((1, 3)),
+                               PLATE_HALF_M[None], np.zeros((1, 3)), medium.rho_kg_m3, medium.eta_pa_s, 1e9,
+                               angles, cl, cd, 1)
+    return float(-force[0, 0])
+
+
+def towed_plate(settings: SphSettings, medium: Medium, speed_m_s: float, angle_deg: float, shrink: bool,
+                seconds: float = 0.3) -> dict:
+    """The plate, its face at ``angle_deg`` to the tow (90: broadside), towed along +x at mid-depth."""
+    half_angle = math.radians(angle_deg) / 2
+    quat = np.array([0.0, math.sin(half_angle), 0.0, math.cos(half_angle)])   # about y: local z (the normal) tilts to x
+    depth = 0.3
+    start = np.array([-0.6, 0.0, -depth])
+    tank = Tank(settings, medium, (2.2, 1.0, 0.6), PLATE_HALF_M, start, quat, shrink)
+    steps = int(round(seconds / tank.dt))
+    velocity = np.array([speed_m_s, 0.0, 0.0])
+    try:
+        drag = np.array([-tank.step(start + velocity * (k + 1) * tank.dt, quat, velocity)[0] for k in range(steps)])
+    finally:
+        tank.close()
+    mean, sd = windowed(drag[steps // 3:], tank.dt)       # past the start's added-mass transient
+    model = plate_model_drag(medium, speed_m_s, quat)
+    return {"speed_m_s": speed_m_s, "angle_deg": angle_deg, "drag_n": mean, "window_sd_n": sd, "plate_model_n": model,
+            "ratio": mean / model if model > 1e-6 else None}
+
+
+def floating_box(settings: SphSettings, medium: Medium, shrink: bool, seconds: float = 1.0) -> dict:
+    """A box of density 500 let go at the surface, free to move vertically: its draft."""
+    mass = FLOAT_DENSITY_KG_M3 * float(np.prod(2 * FLOAT_HALF_M))
+    z = 0.0                                     # centre at the surface: half submerged, the expected draft
+    tank = Tank(settings, medium, (1.2, 1.2, 0.6), FLOAT_HALF_M, [0.0, 0.0, z], IDENTITY, shrink)
+    v, heights = 0.0, []
+    try:
+        for _ in range(int(round(seconds / tank.dt))):
+            force = tank.step([0.0, 0.0, z], IDENTITY, [0.0, 0.0, v])[2]
+            v += (force / mass - 9.81) * tank.dt       # semi-implicit Euler, vertical only
+            z += v * tank.dt
+            heights.append(z)
+    finally:
+        tank.close()
+    tail = np.array(heights[len(heights) // 2:])
+    draft = FLOAT_HALF_M[2] - float(tail.mean())
+    expected = 2 * FLOAT_HALF_M[2] * FLOAT_DENSITY_KG_M3 / medium.rho_kg_m3
+    return {"draft_m": draft, "expected_m": expected, "ratio": draft / expected}
+
+
+def towed_swimmer(settings: SphSettings, medium: Medium, speed_m_s: float, shrink: bool, seconds: float = 0.3) -> dict:
+    """The glide-posed swimmer (``validate drag``'s pose) towed along +x."""
+    body = load_body()
+    glide = glide_state(body)
+    pos = glide.pos_m - np.array([glide.pos_m[:, 0].mean() + 0.4, 0.0, 0.0])
+    tank = Tank(settings, medium, (3.4, 1.5, 0.7), body.half_extents_m, pos, glide.quat_xyzw, shrink)
+    velocity = np.tile([speed_m_s, 0.0, 0.0], (len(pos), 1))
+    steps = int(round(seconds / tank.dt))
+    try:
+        drag = np.array([-tank.step(pos + velocity * (k + 1) * tank.dt, glide.quat_xyzw, velocity)[0]
+                         for k in range(steps)])
+    finally:
+        tank.close()
+    mean, sd = windowed(drag[steps // 3:], tank.dt)
+    reference = REFERENCE_PASSIVE_DRAG_N_S2_M2 * speed_m_s**2
+    return {"speed_m_s": speed_m_s, "drag_n": mean, "window_sd_n": sd, "reference_n": reference,
+            "ratio": mean / reference}
+
+
+def validate_sph(settings: SphSettings = SphSettings(), medium: Medium = Medium(), progress=None) -> dict:
+    """Every case, before (raw boxes) and after (shrunk) the correction."""
+    say = progress or (lambda _: None)
+    out = {"particle_radius_m": settings.particle_radius_m, "mesh_shrink_radii": settings.mesh_shrink_radii,
+           "window_s": WINDOW_S}
+    for label, shrink in (("before", False), ("after", True)):
+        say(f"{label}: held box")
+        out[label] = {
+            "held_box_full": held_box(settings, medium, -0.5, shrink),
+            "held_box_half": held_box(settings, medium, 0.0, shrink),
+        }
+        say(f"{label}: floating box")
+        out[label]["floating_box"] = floating_box(settings, medium, shrink)
+        say(f"{label}: towed plate")
+        out[label]["towed_plate"] = [towed_plate(settings, medium, v, a, shrink)
+                                     for a in TOW_ANGLES_DEG for v in TOW_SPEEDS_M_S]
+        say(f"{label}: towed swimmer")
+        out[label]["towed_swimmer"] = [towed_swimmer(settings, medium, v, shrink) for v in SWIMMER_SPEEDS_M_S]
+    return out

@@ -1,0 +1,182 @@
+"""The SPH fluid backend (``sph``): SPlisHSPlasH's DFSPH water in a pool, two-way coupled.
+
+Each swimmer segment is a rigid boundary box in the water, placed every physics step where
+PyBullet has it; the force and torque the water puts on it go back to PyBullet through the same
+``FluidWrenches`` as the thin plates'. The solver runs in a worker process (``worker.py``).
+
+A new episode (``reset``) builds a fresh pool around the swimmer's start on the first step:
+water inside the body is removed and the rest settles, damped, around the body held still
+(``settle_s``, reported in ``startup``), before the swim starts.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from layered_swim.body.model import Body
+from layered_swim.config import ConfigError
+from layered_swim.fluid.backend import FluidBackend, FluidError, FluidWrenches
+from layered_swim.fluid.medium import Medium
+from layered_swim.fluid.sph.settings import SphSettings
+from layered_swim.geometry import quat_rotate
+from layered_swim.state import BodyState
+
+MAX_WATER_SPEED_M_S = 30.0     # a particle faster than this: the fluid blew up
+HEADROOM_M = 0.4               # container wall above the surface, so splashes stay in
+DAMPING_PER_STEP = 0.95        # the settle phase's velocity scaling per step...
+DAMPED_SHARE = 0.7             # ...over this share of it; the rest runs free
+WINDOW_S = 0.02                # per-step SPH forces are noisy (sd ~15 %): peaks are judged on 20 ms means
+
+
+class SphBackend(FluidBackend):
+    name = "sph"
+
+    def __init__(self, body: Body, medium: Medium, gravity_m_s2: float, settings: SphSettings | None = None):
+        super().__init__(body, medium, gravity_m_s2)
+        self.sph_settings = settings or SphSettings()
+        self._check_medium(medium)
+        s = self.sph_settings
+        shrink = s.mesh_shrink_radii * s.particle_radius_m
+        # The correction for SPH's fluid-free skin; never below half the box (thin limbs stay boxes).
+        self.boundary_half_m = np.maximum(body.half_extents_m - shrink, body.half_extents_m / 2)
+        self._worker = None
+        self._last_time_s: float | None = None
+        self.startup: dict = {}
+        self.pool_min_m = self.pool_max_m = None
+        self.solver_s = 0.0            # seconds inside SPlisHSPlasH's step, since the start
+        self.steps = 0
+        self.outside_steps = 0         # steps with a segment centre outside the water box
+        self._window = np.zeros(3)     # total force summed over the current window
+        self.peak_window_force_n = 0.0
+
+    def _check_medium(self, medium: Medium) -> None:
+        if any(medium.current_m_s):
+            raise ConfigError("the SPH pool has no current (README, 'SPH backend'); use --backend plate for currents")
+
+    def set_medium(self, medium: Medium) -> None:
+        self._check_medium(medium)
+        if self._worker is not None and medium != self.medium:
+            raise FluidError("the SPH water cannot change mid-swim")
+        super().set_medium(medium)
+
+    @property
+    def viscosity_m2_s(self) -> float:
+        s = self.sph_settings
+        return s.viscosity_m2_s if s.viscosity_m2_s is not None else self.medium.eta_pa_s / self.medium.rho_kg_m3
+
+    def settings(self) -> dict:
+        s = self.sph_settings
+        return {"pool_size_m": list(s.pool_size_m), "wall_gap_m": s.wall_gap_m,
+                "particle_radius_m": s.particle_radius_m, "time_step_s": s.time_step_s,
+                "viscosity_m2_s": self.viscosity_m2_s, "mesh_shrink_radii": s.mesh_shrink_radii,
+                "settle_s": s.settle_s, "threads": s.solver_threads, "deterministic": s.deterministic}
+
+    def reset(self) -> None:
+        self.close()
+        self._last_time_s = self.pool_min_m = self.pool_max_m = None
+        self.solver_s, self.steps, self.outside_steps, self.peak_window_force_n = 0.0, 0, 0, 0.0
+        self._window = np.zeros(3)
+
+    def close(self) -> None:
+        if self._worker is not None:
+            self._worker.close()
+            self._worker = None
+
+    # -- the pool ----------------------------------------------------------------------------
+    def place_pool(self, state: BodyState) -> None:
+        """An axis-aligned pool: its back wall ``wall_gap_m`` behind the body's rearmost corner
+        (the swimmer heads +x), centred across the swimmer's centre of mass, surface at the medium's."""
+        length, width, depth = self.sph_settings.pool_size_m
+        corners = body_corners(state.pos_m, state.quat_xyzw, self.body.half_extents_m)
+        back = corners[:, 0].min() - self.sph_settings.wall_gap_m
+        if corners[:, 0].max() > back + length or np.ptp(corners[:, 1]) > width:
+            raise ConfigError(f"the swimmer ({np.ptp(corners[:, 0]):.2f} x {np.ptp(corners[:, 1]):.2f} m) does not "
+                              f"fit the {length:g} x {width:g} m SPH pool")
+        centre_y = state.com_m[1]
+        surface = self.medium.surface_z_m
+        self.pool_min_m = np.array([back, centre_y - width / 2, surface - depth])
+        self.pool_max_m = np.array([back + length, centre_y + width / 2, surface + HEADROOM_M])
+
+    def domain_xy_m(self, state: BodyState) -> tuple[np.ndarray, np.ndarray]:
+        if self.pool_min_m is None:
+            self.place_pool(state)
+        return self.pool_min_m[:2], self.pool_max_m[:2]
+
+    def _start(self, state: BodyState) -> None:
+        from layered_swim.fluid.sph.worker import SphWorker
+
+        s = self.sph_settings
+        self.place_pool(state)
+        self._worker = SphWorker(s.solver_threads)
+        self.startup = self._worker.request("start", {
+            "scene": {
+                "pool_min_m": self.pool_min_m, "pool_max_m": self.pool_max_m,
+                "water_top_z_m": self.medium.surface_z_m, "particle_radius_m": s.particle_radius_m,
+                "time_step_s": s.time_step_s, "density_kg_m3": self.medium.rho_kg_m3,
+                "viscosity_m2_s": self.viscosity_m2_s, "gravity_m_s2": self.gravity_m_s2,
+                "boxes_half_m": self.boundary_half_m, "box_centres_m": state.pos_m.copy(),
+            },
+            "viscosity_m2_s": self.viscosity_m2_s, "pos_m": state.pos_m.copy(), "quat_xyzw": state.quat_xyzw.copy(),
+            "settle_s": s.settle_s, "damped_share": DAMPED_SHARE, "damping_per_step": DAMPING_PER_STEP,
+        })
+
+    def wrenches(self, state: BodyState) -> FluidWrenches:
+        if self._worker is None:
+            self._start(state)
+        elif not math.isclose(state.time_s - self._last_time_s, self.sph_settings.time_step_s, abs_tol=1e-9):
+            raise FluidError(f"the SPH step ({self.sph_settings.time_step_s:.6g} s) must equal the physics step "
+                             f"({state.time_s - self._last_time_s:.6g} s)")
+        self._last_time_s = state.time_s
+        self._check_inside(state)
+        force, torque, solver_s, flow, max_speed = self._worker.request(
+            "step", (state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s))
+        self.solver_s += solver_s
+        self.steps += 1
+        self._window += force.sum(axis=0)
+        per_window = max(1, round(WINDOW_S / self.sph_settings.time_step_s))
+        if self.steps % per_window == 0:
+            self.peak_window_force_n = max(self.peak_window_force_n, float(np.linalg.norm(self._window)) / per_window)
+            self._window[:] = 0.0
+        if not (max_speed < MAX_WATER_SPEED_M_S and np.isfinite(force).all() and np.isfinite(torque).all()):
+            raise FluidError(f"the SPH water blew up at t = {state.time_s:.3f} s (a particle at {max_speed:.3g} m/s); "
+                             "try a smaller time step or particle radius")
+        return FluidWrenches(force, torque, flow, None)
+
+    def _check_inside(self, state: BodyState) -> None:
+        lo, hi = self.pool_min_m, self.pool_max_m
+        com = state.com_m
+        if not (lo[0] < com[0] < hi[0] and lo[1] < com[1] < hi[1]):
+            raise FluidError(f"the swimmer left the {hi[0] - lo[0]:g} x {hi[1] - lo[1]:g} m SPH pool at "
+                             f"t = {state.time_s:.2f} s (centre of mass at x = {com[0]:.2f}, y = {com[1]:.2f} m)")
+        if not (np.all(state.pos_m[:, :2] > lo[:2]) and np.all(state.pos_m[:, :2] < hi[:2])
+                and np.all(state.pos_m[:, 2] > lo[2])):
+            self.outside_steps += 1
+
+    def particles(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Positions (k, 3) and speeds (k,) of every water particle now; None before the first
+        step builds the water."""
+        if self._worker is None:
+            return None
+        positions, velocities = self._worker.request("particles")
+        return positions, np.linalg.norm(velocities, axis=1)
+
+    def report(self) -> dict:
+        """What the run's summary says about the water."""
+        return {**self.startup, "pool_min_m": _listed(self.pool_min_m), "pool_max_m": _listed(self.pool_max_m),
+                "steps": self.steps, "solver_s": round(self.solver_s, 3),
+                "steps_with_segment_outside_pool": self.outside_steps,
+                "peak_total_force_n": self.peak_window_force_n, "window_s": WINDOW_S}
+
+
+def body_corners(pos_m: np.ndarray, quat_xyzw: np.ndarray, half_m: np.ndarray) -> np.ndarray:
+    """The eight corners of every segment's box, world frame, (8 n, 3)."""
+    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+    local = signs[None, :, :] * half_m[:, None, :]                        # (n, 8, 3)
+    quats = np.repeat(quat_xyzw[:, None, :], 8, axis=1)
+    return (quat_rotate(quats, local) + pos_m[:, None, :]).reshape(-1, 3)
+
+
+def _listed(values) -> list | None:
+    return None if values is None else [round(float(v), 4) for v in values]

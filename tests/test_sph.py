@@ -1,0 +1,142 @@
+"""The SPH backend: settings, scene files, the worker's failure handling, and tiny coupled runs
+(a coarse tank and a coarse pool, so the whole file takes seconds)."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from layered_swim.analysis.sph_validation import Tank, windowed
+from layered_swim.body.model import load_body
+from layered_swim.config import ConfigError
+from layered_swim.episode import Episode
+from layered_swim.fluid import FluidError, make_fluid
+from layered_swim.fluid.medium import Medium
+from layered_swim.fluid.sph import SphSettings
+from layered_swim.fluid.sph.scene import box_obj
+from layered_swim.fluid.sph.worker import SphWorker
+
+COARSE = dict(particle_radius_m=0.05, settle_s=0.2, deterministic=True)
+IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("particle_radius_m", 0.0, "particle_radius_m"),
+    ("particle_radius_m", float("nan"), "particle_radius_m"),
+    ("pool_size_m", (3.0, 1.5, float("nan")), "water depth"),
+    ("threads", 0, "threads"),
+    ("settle_s", 0.05, "settle_s"),
+    ("pool_size_m", (50.0, 50.0, 10.0), "particles"),
+])
+def test_bad_settings_are_one_line(field, value, message):
+    with pytest.raises(ConfigError, match=message):
+        SphSettings(**{field: value})
+
+
+def test_a_pool_smaller_than_the_swimmer_is_refused():
+    episode = Episode("breaststroke", backend="sph", fluid_settings=SphSettings(pool_size_m=(1.0, 1.0, 0.5), **COARSE))
+    with pytest.raises(ConfigError, match="does not fit the 1 x 1 m SPH pool"):
+        episode.run(steps=1)
+    episode.close()
+
+
+def test_without_the_extra_the_backend_says_how_to_install(monkeypatch):
+    import layered_swim.fluid as fluid
+
+    monkeypatch.setattr(fluid, "find_spec", lambda name: None)
+    with pytest.raises(ConfigError, match=r"pip install -e '\.\[sph\]'"):
+        make_fluid("sph", load_body(), Medium(), 9.81)
+
+
+def test_the_pool_has_no_current():
+    with pytest.raises(ConfigError, match="no current"):
+        make_fluid("sph", load_body(), Medium(current_m_s=(0.3, 0.0, 0.0)), 9.81)
+
+
+def test_box_mesh_is_closed_with_outward_faces():
+    lines = box_obj([0.1, 0.2, 0.3]).splitlines()
+    vertices = np.array([[float(v) for v in line.split()[1:]] for line in lines if line.startswith("v ")])
+    faces = [[int(i) - 1 for i in line.split()[1:]] for line in lines if line.startswith("f ")]
+    # Signed volume by the divergence theorem: positive only if every face points outward.
+    volume = sum(np.dot(vertices[a], np.cross(vertices[b], vertices[c])) for a, b, c in faces) / 6
+    assert len(faces) == 12 and volume == pytest.approx(0.2 * 0.4 * 0.6)
+
+
+def test_a_failing_request_is_one_error_and_a_dead_worker_too():
+    worker = SphWorker(1)
+    with pytest.raises(FluidError, match="unknown request 'nonsense'"):
+        worker.request("nonsense")
+    worker._process.kill()
+    with pytest.raises(FluidError, match="process died during 'particles'"):
+        worker.request("particles")
+    worker.close()
+
+
+def test_held_box_buoyancy_is_rho_g_v_within_30_percent():
+    settings = SphSettings(particle_radius_m=0.03, settle_s=0.3, deterministic=True)
+    half = np.array([0.15, 0.15, 0.15])
+    tank = Tank(settings, Medium(), (0.9, 0.9, 0.7), half, [0.0, 0.0, -0.3], IDENTITY, shrink=True)
+    try:
+        lift = np.array([tank.step([0.0, 0.0, -0.3], IDENTITY, np.zeros(3))[2] for _ in range(96)])
+    finally:
+        tank.close()
+    expected = Medium().rho_kg_m3 * 9.81 * 0.3**3
+    mean, _ = windowed(lift, settings.time_step_s)
+    assert mean > 0 and abs(mean / expected - 1) < 0.3
+
+
+def test_a_short_coupled_swim_stays_finite_and_is_reported():
+    episode = Episode("breaststroke", backend="sph", fluid_settings=SphSettings(**COARSE))
+    forces = []
+    try:
+        episode.run(0.1, observers=[lambda sim: forces.append(sim.fluid_force_n.copy())])
+        report = episode.sim.fluid.report()
+        water = episode.sim.fluid.particles()
+    finally:
+        episode.close()
+    forces = np.array(forces)
+    assert np.isfinite(forces).all() and np.isfinite(episode.sim.state.pos_m).all()
+    assert forces[:, :, 2].sum(axis=1).mean() > 0          # the water holds the body up
+    assert report["steps"] == 48 and report["fluid_particles"] > 500 and report["removed_particles"] > 0
+    assert 0 < report["peak_total_force_n"] < 3 * 89.57 * 9.81
+    positions, speeds = water
+    assert positions.shape == (report["fluid_particles"], 3) and np.isfinite(speeds).all()
+
+
+def test_one_thread_runs_are_bit_identical():
+    def forces():
+        episode = Episode("breaststroke", backend="sph", fluid_settings=SphSettings(**COARSE))
+        try:
+            episode.run(steps=12)
+            return episode.sim.fluid_force_n.copy()
+        finally:
+            episode.close()
+
+    np.testing.assert_array_equal(forces(), forces())
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "layered_swim", *args], capture_output=True, text=True, timeout=300)
+
+
+def test_cli_run_on_sph_writes_the_water_report(tmp_path):
+    done = _cli("run", "--backend", "sph", "--stroke", "breaststroke", "--seconds", "0.1", "--particle-radius", "0.05",
+                "--deterministic", "--json", "--out", str(tmp_path / "r"))
+    assert done.returncode == 0, done.stderr
+    summary = json.loads(done.stdout)
+    assert summary["fluid"]["within_force_bound"] is True
+    config = json.loads((tmp_path / "r" / "config.json").read_text())
+    assert config["fluid_backend"]["name"] == "sph"
+    assert config["fluid_backend"]["settings"]["particle_radius_m"] == 0.05
+
+
+@pytest.mark.parametrize("args, message", [
+    (["run", "--stroke", "breaststroke", "--particle-radius", "0"], "particle_radius_m"),
+    (["follow", "figure_eight", "--seconds", "60"], "leaves the 3 x 1.5 m SPH pool"),
+    (["validate", "drag"], "validate sph"),
+])
+def test_cli_refuses_bad_sph_input_in_one_line(args, message):
+    done = _cli(*args, "--backend", "sph")
+    assert done.returncode == 2
+    assert message in done.stderr and len(done.stderr.strip().splitlines()) == 1
