@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import asdict
 import math
 import os
 import sys
@@ -62,14 +63,14 @@ def _parser() -> argparse.ArgumentParser:
     follow.add_argument("--seconds", type=float, default=60.0)
     follow.add_argument("--out", help="output folder (default runs/follow-<trajectory>-<timestamp>)")
     follow.add_argument("--json", action="store_true")
-    _backend_option(follow)
+    _backend_option(follow, pool="large")       # a trajectory's target starts 2 m ahead
 
     goal = sub.add_parser("goal", help="SWIM's goal-reaching benchmark (Pos, Prog, Dev, Roll)")
     goal.add_argument("--pool", choices=("small", "large"), default="small")
     goal.add_argument("--stroke", default="front_crawl")
     steering_options(goal, density=False)
     goal.add_argument("--json", action="store_true")
-    _backend_option(goal, pool=False)
+    _backend_option(goal, pool=None)
 
     render = sub.add_parser("render", help="draw a run folder or a trajectory swim to a video or PNG frames, no display needed")
     render.add_argument("source", help="a folder written by `run`/`follow --out` (replayed), or a trajectory (swum now)")
@@ -81,7 +82,7 @@ def _parser() -> argparse.ArgumentParser:
     steering_options(render)
     render.add_argument("--forces", action="store_true", help="draw the per-segment fluid-force arrows")
     render.add_argument("--no-progress", action="store_true", help="no progress bar")
-    _backend_option(render)
+    _backend_option(render, pool="large")
 
     analyze = sub.add_parser("analyze", help="swim steadily and report per-cycle stroke metrics, plots and a report")
     analyze.add_argument("--stroke", required=True, help="stroke name (see `strokes`) or path to a stroke .yaml")
@@ -93,6 +94,7 @@ def _parser() -> argparse.ArgumentParser:
         _water_options(command)
         _current_option(command)
         command.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+        _backend_option(command)
     analyze.add_argument("--out", help="output folder (default runs/analyze-<stroke>-<timestamp>)")
     compare.add_argument("--out", help="output folder (default runs/compare-<timestamp>)")
     _parallel_options(compare)
@@ -122,14 +124,15 @@ def _water_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--physics-hz", type=int, default=480)
 
 
-def _backend_option(command: argparse.ArgumentParser, pool: bool = True) -> None:
-    """--backend and the SPH water's options (used only with --backend sph)."""
+def _backend_option(command: argparse.ArgumentParser, pool: str | None = "small") -> None:
+    """--backend and the SPH water's options (used only with --backend sph); ``pool``: the
+    default SPH pool (None: the command has its own --pool)."""
     command.add_argument("--backend", default="plate",
                          help="fluid model: plate (thin plates + buoyancy, default) or sph (SPlisHSPlasH, the [sph] extra)")
     sph = command.add_argument_group("SPH water (with --backend sph)")
     if pool:
-        sph.add_argument("--pool", choices=("small", "large"), default="small",
-                         help="SWIM's pool: small 3 x 1.5 x 0.5 m (default), large 5 x 2 x 0.7 m")
+        sph.add_argument("--pool", choices=("small", "large"), default=pool,
+                         help=f"SWIM's pool: small 3 x 1.5 x 0.5 m, large 5 x 2 x 0.7 m (default {pool})")
     sph.add_argument("--particle-radius", type=float, default=0.025, metavar="M", help="default 0.025 m")
     sph.add_argument("--threads", type=int, metavar="N", help="solver threads (default: every core)")
     sph.add_argument("--deterministic", action="store_true", help="one solver thread: bit-identical runs")
@@ -374,8 +377,10 @@ def _cmd_render(args) -> None:
 def _analysis_config(args, stroke: str) -> dict:
     from layered_swim.analysis.stroke_analysis import analysis_config
 
+    settings = _fluid_settings(args)
     return analysis_config(stroke, args.seconds, args.density, _vector(args.current, "--current"),
-                           args.fluid, args.settle, args.seed, args.physics_hz)
+                           args.fluid, args.settle, args.seed, args.physics_hz, args.backend,
+                           None if settings is None else asdict(settings))
 
 
 def _summary_rows(result: dict) -> list[list[str]]:

@@ -133,10 +133,20 @@ def test_cli_run_on_sph_writes_the_water_report(tmp_path):
 
 @pytest.mark.parametrize("args, message", [
     (["run", "--stroke", "breaststroke", "--particle-radius", "0"], "particle_radius_m"),
-    (["follow", "figure_eight", "--seconds", "60"], "leaves the 3 x 1.5 m SPH pool"),
+    (["follow", "figure_eight", "--seconds", "60"], "leaves the 5 x 2 m SPH pool"),
     (["validate", "drag"], "validate sph"),
 ])
 def test_cli_refuses_bad_sph_input_in_one_line(args, message):
     done = _cli(*args, "--backend", "sph")
     assert done.returncode == 2
     assert message in done.stderr and len(done.stderr.strip().splitlines()) == 1
+
+
+def test_water_colours_run_from_faint_blue_to_opaque_white():
+    from layered_swim.render.scene import SPEED_COLOR_MAX_M_S, speed_colors
+
+    colours = speed_colors(np.array([0.0, SPEED_COLOR_MAX_M_S / 2, SPEED_COLOR_MAX_M_S, 10.0]))
+    assert colours[0, 2] > colours[0, 0] and colours[0, 3] == pytest.approx(0.2)
+    np.testing.assert_allclose(colours[2], [1.0, 1.0, 1.0, 1.0])
+    np.testing.assert_allclose(colours[3], colours[2])              # faster water is clipped
+    assert np.all(np.diff(colours[:3, 3]) > 0)

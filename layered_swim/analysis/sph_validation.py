@@ -23,7 +23,8 @@ from layered_swim.fluid.coefficients import build_coefficient_table
 from layered_swim.fluid.medium import Medium
 from layered_swim.fluid.plate import _plate_wrenches
 from layered_swim.fluid.sph import SphSettings
-from layered_swim.fluid.sph.backend import DAMPED_SHARE, DAMPING_PER_STEP, HEADROOM_M
+from layered_swim.fluid.backend import FluidError
+from layered_swim.fluid.sph.backend import DAMPED_SHARE, DAMPING_PER_STEP, HEADROOM_M, MAX_WATER_SPEED_M_S
 from layered_swim.fluid.sph.worker import SphWorker
 
 WINDOW_S = 0.02
@@ -34,6 +35,8 @@ FLOAT_DENSITY_KG_M3 = 500.0
 TOW_SPEEDS_M_S = (0.5, 1.0, 1.5)
 TOW_ANGLES_DEG = (0.0, 30.0, 60.0, 90.0)
 SWIMMER_SPEEDS_M_S = (1.0, 1.5)
+RAMP_S = 0.1              # tows speed up over this long: an impulsive start throws particles out
+TOW_S = 0.4               # each tow; forces are averaged over its second half
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 
@@ -52,10 +55,11 @@ class Tank:
         self.startup = self.worker.request("start", {
             "scene": {"pool_min_m": np.array([-length / 2, -width / 2, -depth]),
                       "pool_max_m": np.array([length / 2, width / 2, HEADROOM_M]),
-                      "water_top_z_m": 0.0, "particle_radius_m": r, "time_step_s": self.dt,
+                      "particle_radius_m": r, "time_step_s": self.dt,
                       "density_kg_m3": medium.rho_kg_m3, "viscosity_m2_s": viscosity, "gravity_m_s2": gravity_m_s2,
                       "boxes_half_m": self.half_m, "box_centres_m": np.atleast_2d(pos_m)},
-            "viscosity_m2_s": viscosity, "pos_m": np.atleast_2d(pos_m), "quat_xyzw": np.atleast_2d(quat_xyzw),
+            "viscosity_m2_s": viscosity, "surface_z_m": 0.0, "pos_m": np.atleast_2d(pos_m),
+            "quat_xyzw": np.atleast_2d(quat_xyzw),
             "settle_s": settings.settle_s, "damped_share": DAMPED_SHARE, "damping_per_step": DAMPING_PER_STEP,
         })
 
@@ -64,8 +68,8 @@ class Tank:
         pos, quat = np.atleast_2d(pos_m), np.atleast_2d(quat_xyzw)
         force, _, _, _, max_speed = self.worker.request("step", (pos, quat, np.atleast_2d(linvel_m_s),
                                                                  np.zeros_like(pos)))
-        if not max_speed < 30.0:
-            raise RuntimeError(f"SPH water blew up (a particle at {max_speed:.3g} m/s)")
+        if not max_speed < MAX_WATER_SPEED_M_S:
+            raise FluidError(f"the SPH water blew up (a particle at {max_speed:.3g} m/s)")
         return force.sum(axis=0)
 
     def close(self) -> None:
@@ -103,21 +107,31 @@ def plate_model_drag(medium: Medium, speed_m_s: float, quat_xyzw: np.ndarray) ->
     return float(-force[0, 0])
 
 
-def towed_plate(settings: SphSettings, medium: Medium, speed_m_s: float, angle_deg: float, shrink: bool,
-                seconds: float = 0.3) -> dict:
+def tow(tank: Tank, start_m: np.ndarray, quat_xyzw: np.ndarray, speed_m_s: float) -> np.ndarray:
+    """Tow the tank's boxes along +x, ramping up to ``speed_m_s``; the drag (N, against the tow)
+    over the second half of the tow."""
+    position, drag = np.array(start_m, dtype=float), []
+    steps = int(round(TOW_S / tank.dt))
+    for k in range(steps):
+        speed = speed_m_s * min(1.0, (k + 1) * tank.dt / RAMP_S)
+        velocity = np.zeros_like(position)
+        velocity[..., 0] = speed
+        position = position + velocity * tank.dt
+        drag.append(-tank.step(position, quat_xyzw, velocity)[0])
+    return np.array(drag[steps // 2:])
+
+
+def towed_plate(settings: SphSettings, medium: Medium, speed_m_s: float, angle_deg: float, shrink: bool) -> dict:
     """The plate, its face at ``angle_deg`` to the tow (90: broadside), towed along +x at mid-depth."""
     half_angle = math.radians(angle_deg) / 2
     quat = np.array([0.0, math.sin(half_angle), 0.0, math.cos(half_angle)])   # about y: local z (the normal) tilts to x
     depth = 0.3
     start = np.array([-0.6, 0.0, -depth])
     tank = Tank(settings, medium, (2.2, 1.0, 0.6), PLATE_HALF_M, start, quat, shrink)
-    steps = int(round(seconds / tank.dt))
-    velocity = np.array([speed_m_s, 0.0, 0.0])
     try:
-        drag = np.array([-tank.step(start + velocity * (k + 1) * tank.dt, quat, velocity)[0] for k in range(steps)])
+        mean, sd = windowed(tow(tank, start, quat, speed_m_s), tank.dt)
     finally:
         tank.close()
-    mean, sd = windowed(drag[steps // 3:], tank.dt)       # past the start's added-mass transient
     model = plate_model_drag(medium, speed_m_s, quat)
     return {"speed_m_s": speed_m_s, "angle_deg": angle_deg, "drag_n": mean, "window_sd_n": sd, "plate_model_n": model,
             "ratio": mean / model if model > 1e-6 else None}
@@ -143,20 +157,16 @@ def floating_box(settings: SphSettings, medium: Medium, shrink: bool, seconds: f
     return {"draft_m": draft, "expected_m": expected, "ratio": draft / expected}
 
 
-def towed_swimmer(settings: SphSettings, medium: Medium, speed_m_s: float, shrink: bool, seconds: float = 0.3) -> dict:
+def towed_swimmer(settings: SphSettings, medium: Medium, speed_m_s: float, shrink: bool) -> dict:
     """The glide-posed swimmer (``validate drag``'s pose) towed along +x."""
     body = load_body()
     glide = glide_state(body)
     pos = glide.pos_m - np.array([glide.pos_m[:, 0].mean() + 0.4, 0.0, 0.0])
     tank = Tank(settings, medium, (3.4, 1.5, 0.7), body.half_extents_m, pos, glide.quat_xyzw, shrink)
-    velocity = np.tile([speed_m_s, 0.0, 0.0], (len(pos), 1))
-    steps = int(round(seconds / tank.dt))
     try:
-        drag = np.array([-tank.step(pos + velocity * (k + 1) * tank.dt, glide.quat_xyzw, velocity)[0]
-                         for k in range(steps)])
+        mean, sd = windowed(tow(tank, pos, glide.quat_xyzw, speed_m_s), tank.dt)
     finally:
         tank.close()
-    mean, sd = windowed(drag[steps // 3:], tank.dt)
     reference = REFERENCE_PASSIVE_DRAG_N_S2_M2 * speed_m_s**2
     return {"speed_m_s": speed_m_s, "drag_n": mean, "window_sd_n": sd, "reference_n": reference,
             "ratio": mean / reference}

@@ -21,6 +21,7 @@ from layered_swim.config import ConfigError
 from layered_swim.control.stroke import stroke_path
 from layered_swim.episode import Episode
 from layered_swim.fluid import make_fluid
+from layered_swim.fluid.sph import SphSettings
 from layered_swim.runs import check_seconds, make_medium, record, resolved_config, write_json
 
 ANALYSIS_LOG_HZ = 120      # ~100 samples per stroke cycle for the profiles
@@ -30,19 +31,22 @@ PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_fi
 
 def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | None = None,
                     current_m_s=(0.0, 0.0, 0.0), fluid: str = "fresh_water", settle_s: float = SETTLE_S,
-                    seed: int = 0, physics_hz: int = 480) -> dict:
-    """The resolved, JSON-able configuration of one analysis (also its cache key)."""
+                    seed: int = 0, physics_hz: int = 480, backend: str = "plate", sph: dict | None = None) -> dict:
+    """The resolved, JSON-able configuration of one analysis (also its cache key); ``sph``: the
+    SPH settings' fields, with ``backend="sph"``."""
     check_seconds(seconds)
     if not (math.isfinite(settle_s) and 0.0 <= settle_s < seconds):
         raise ConfigError(f"settle time must be at least 0 and shorter than the swim ({seconds:g} s), got {settle_s}")
     return {"stroke": stroke, "stroke_file_sha256": file_sha256(stroke_path(stroke)), "seconds": float(seconds),
             "density_kg_m3": density_kg_m3, "current_m_s": [float(c) for c in current_m_s], "fluid": fluid,
-            "settle_s": float(settle_s), "seed": seed, "physics_hz": physics_hz}
+            "settle_s": float(settle_s), "seed": seed, "physics_hz": physics_hz, "backend": backend, "sph": sph}
 
 
 def analyze_stroke(config: dict, progress: bool = False) -> dict:
     medium = make_medium(config["fluid"], config["density_kg_m3"], config["current_m_s"])
-    episode = Episode(config["stroke"], medium=medium, physics_hz=config["physics_hz"], seed=config["seed"])
+    settings = SphSettings(**config["sph"]) if config.get("sph") else None
+    episode = Episode(config["stroke"], medium=medium, physics_hz=config["physics_hz"], seed=config["seed"],
+                      backend=config.get("backend", "plate"), fluid_settings=settings)
     sim, stroke = episode.sim, episode.stroke
     recorder = record(episode, config["seconds"], ANALYSIS_LOG_HZ, progress, joint_work=True)
     posture = stroke.start.posture
@@ -50,9 +54,11 @@ def analyze_stroke(config: dict, progress: bool = False) -> dict:
                                                         config["settle_s"]))
     summary = result["summary"]
     speed = summary["mean_speed_m_s"]["mean"]
-    # The same body towed in a streamlined glide at the swimming speed: what the stroke adds.
-    towed = make_fluid(sim.fluid.name, sim.body, sim.fluid.medium, sim.config.gravity_m_s2)
-    summary["passive_drag_n"] = towed_drag(towed, (abs(speed),))[0]["drag_n"] if posture == "prone" else None
+    # The same body towed in a streamlined glide at the swimming speed: what the stroke adds. A
+    # fluid with memory (SPH) cannot be read in one evaluation: `validate sph` tows it instead.
+    towed = make_fluid(sim.fluid.name, sim.body, sim.fluid.medium, sim.config.gravity_m_s2) if settings is None else None
+    summary["passive_drag_n"] = (towed_drag(towed, (abs(speed),))[0]["drag_n"]
+                                 if posture == "prone" and towed is not None else None)
     summary["nominal_stroke_rate_cpm"] = 60.0 / stroke.period_s
     return {"stroke": stroke.name, "posture": posture, **result,
             "config": resolved_config(episode, config, ANALYSIS_LOG_HZ)}

@@ -143,10 +143,21 @@ def analyze_log(log: dict, info: SwimmerInfo) -> dict:
     }
 
 
+def _buoyancy_or_zero(buoyancy_n: np.ndarray, thrust_axis: np.ndarray) -> np.ndarray:
+    """The logged buoyancy part of the fluid force. A backend that cannot separate it (SPH) logs
+    NaN; along a horizontal thrust axis buoyancy adds nothing, so the whole force serves there."""
+    if not np.isnan(buoyancy_n).any():
+        return buoyancy_n
+    if abs(float(np.asarray(thrust_axis, dtype=float)[2])) > 1e-6:
+        raise ConfigError("this fluid backend does not separate buoyancy from the rest of the force, so an "
+                          "upright stroke's vertical thrust cannot be analysed with it; use --backend plate")
+    return np.zeros_like(buoyancy_n)
+
+
 def _series(window: dict, seg: dict, posture: str, forward: np.ndarray, thrust_axis: np.ndarray) -> dict:
     """Every per-sample quantity that gets a profile over the cycle."""
     quat = window["segment_quat_xyzw"]
-    hydro = window["fluid_force_n"] - window["buoyancy_force_n"]
+    hydro = window["fluid_force_n"] - _buoyancy_or_zero(window["buoyancy_force_n"], thrust_axis)
     propulsive, resistive = propulsive_resistive_n(hydro, thrust_axis)
     series = {
         "forward_speed_m_s": window["com_vel_m_s"] @ forward,

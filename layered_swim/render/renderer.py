@@ -152,7 +152,9 @@ class Renderer:
         points.color[:] = colors.reshape(-1).tolist()
         self.program["lit"] = 0.0
         gl.glPointSize(3.0)
+        gl.glDepthMask(gl.GL_FALSE)       # translucent: what lies behind still draws
         points.draw(gl.GL_POINTS)
+        gl.glDepthMask(gl.GL_TRUE)
 
     def delete(self) -> None:
         for vertex_list in (self._boxes, self._marker, self._water, self._grid.vertices, self._guides.vertices):

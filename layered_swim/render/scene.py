@@ -138,8 +138,9 @@ SPEED_COLOR_MAX_M_S = 1.5     # water at this speed or faster is drawn white
 
 
 def speed_colors(speeds_m_s: np.ndarray) -> np.ndarray:
-    """RGBA per water particle: deep blue at rest through cyan to white at SPEED_COLOR_MAX_M_S."""
+    """RGBA per water particle: deep blue and faint at rest, through cyan to opaque white at
+    SPEED_COLOR_MAX_M_S, so the swimmer shows through still water and the wake stands out."""
     t = np.clip(np.asarray(speeds_m_s, dtype=float) / SPEED_COLOR_MAX_M_S, 0.0, 1.0)[:, None]
     still, middle, fast = np.array([0.05, 0.2, 0.6]), np.array([0.1, 0.75, 0.95]), np.array([1.0, 1.0, 1.0])
     rgb = np.where(t < 0.5, still + (middle - still) * (2 * t), middle + (fast - middle) * (2 * t - 1))
-    return np.column_stack([rgb, np.ones(len(rgb))])
+    return np.column_stack([rgb, 0.2 + 0.8 * t[:, 0]])

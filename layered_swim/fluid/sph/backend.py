@@ -113,12 +113,13 @@ class SphBackend(FluidBackend):
         self.startup = self._worker.request("start", {
             "scene": {
                 "pool_min_m": self.pool_min_m, "pool_max_m": self.pool_max_m,
-                "water_top_z_m": self.medium.surface_z_m, "particle_radius_m": s.particle_radius_m,
+                "particle_radius_m": s.particle_radius_m,
                 "time_step_s": s.time_step_s, "density_kg_m3": self.medium.rho_kg_m3,
                 "viscosity_m2_s": self.viscosity_m2_s, "gravity_m_s2": self.gravity_m_s2,
                 "boxes_half_m": self.boundary_half_m, "box_centres_m": state.pos_m.copy(),
             },
-            "viscosity_m2_s": self.viscosity_m2_s, "pos_m": state.pos_m.copy(), "quat_xyzw": state.quat_xyzw.copy(),
+            "viscosity_m2_s": self.viscosity_m2_s, "surface_z_m": self.medium.surface_z_m,
+            "pos_m": state.pos_m.copy(), "quat_xyzw": state.quat_xyzw.copy(),
             "settle_s": s.settle_s, "damped_share": DAMPED_SHARE, "damping_per_step": DAMPING_PER_STEP,
         })
 

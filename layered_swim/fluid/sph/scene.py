@@ -25,12 +25,12 @@ def box_obj(half_extents_m) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_scene(folder: Path, *, pool_min_m, pool_max_m, water_top_z_m: float, particle_radius_m: float,
+def write_scene(folder: Path, *, pool_min_m, pool_max_m, fill_top_z_m: float, particle_radius_m: float,
                 time_step_s: float, density_kg_m3: float, viscosity_m2_s: float, gravity_m_s2: float,
                 boxes_half_m, box_centres_m) -> Path:
     """Write the scene (container, one block of water, one dynamic box per body) into ``folder``
     and return the scene file. The container is ``pool_min_m``..``pool_max_m`` (its top above the
-    water so a wave stays in); the water fills it up to ``water_top_z_m``."""
+    water so a wave stays in); the water block fills it up to ``fill_top_z_m``."""
     folder.mkdir(parents=True, exist_ok=True)
     lo, hi = np.asarray(pool_min_m, float), np.asarray(pool_max_m, float)
     (folder / "pool.obj").write_text(box_obj((hi - lo) / 2))
@@ -64,7 +64,7 @@ def write_scene(folder: Path, *, pool_min_m, pool_max_m, water_top_z_m: float, p
         }],
         "FluidBlocks": [{
             "denseMode": 0, "id": "Fluid",
-            "start": _floats(lo + inset), "end": _floats([hi[0] - inset, hi[1] - inset, water_top_z_m]),
+            "start": _floats(lo + inset), "end": _floats([hi[0] - inset, hi[1] - inset, fill_top_z_m]),
         }],
         "RigidBodies": bodies,
     }

@@ -25,7 +25,7 @@ class SphSettings:
     particle_radius_m: float = 0.025
     time_step_s: float = PHYSICS_STEP_S
     viscosity_m2_s: float | None = None
-    mesh_shrink_radii: float = 1.2
+    mesh_shrink_radii: float = 1.0
     settle_s: float = 0.5
     threads: int | None = None       # None: every core
     deterministic: bool = False      # one thread: bit-identical runs

@@ -63,7 +63,7 @@ class SphSolver:
 
     def __init__(self, scene_file: str, output_dir: str, half_extents_m: np.ndarray, time_step_s: float,
                  viscosity_m2_s: float, particle_radius_m: float):
-        self.sph = sph = import_sph()
+        sph = import_sph()
         self.base = base = sph.Exec.SimulatorBase()
         base.init(sceneFile=scene_file, useGui=False, useCache=False, outputDir=output_dir, initialPause=False)
         base.initSimulation()
@@ -95,6 +95,7 @@ class SphSolver:
                                       for k in range(sim.numberOfBoundaryModels()))
 
     def _set_viscosity(self, viscosity_m2_s: float) -> None:
+        """Set on the model too: the scene file's key for it has moved between releases."""
         if viscosity_m2_s > 0:
             self.fluid.setValueInt(self.fluid.VISCOSITY_METHOD, 1)   # standard (XSPH-like) viscosity
             visc = self.fluid.getViscosityBase()
@@ -157,21 +158,32 @@ class SphSolver:
         return self._timed(self.base.updateBoundaryParticles, False)
 
     def remove_inside(self, pos_m, quat_xyzw, margin_m: float) -> int:
-        """Remove the water inside (and within ``margin_m`` of) the boxes at this pose, and restart
-        the fluid from the rest. Returns how many particles went."""
+        """Remove the water inside (and within ``margin_m`` of) the boxes at this pose. Returns
+        how many particles went."""
         x = self.positions().astype(float)
         keep = np.ones(len(x), dtype=bool)
         rotations = _quat_matrix(quat_xyzw)
         for k in range(len(self.bodies)):
             local = (x - pos_m[k]) @ rotations[k]     # world -> box frame
             keep &= ~np.all(np.abs(local) < self.half[k] + margin_m, axis=1)
-        count = int(keep.sum())
-        for field in ("position", "position0", "velocity"):
-            buffer = np.asarray(self.fluid.getFieldBuffer(field))
-            buffer[:count] = buffer[: len(x)][keep]
+        return self.keep(keep)
+
+    def remove_above(self, z_m: float) -> int:
+        """Remove the water above height ``z_m`` (the fill's excess over the surface)."""
+        return self.keep(self.positions()[:, 2] < z_m)
+
+    def keep(self, mask: np.ndarray) -> int:
+        """Keep only the particles in ``mask`` and restart the fluid from them, where they are
+        now and at rest (SPlisHSPlasH's reset puts particles back at their stored start
+        positions: those become the present ones). Returns how many particles went."""
+        count, total = int(mask.sum()), len(mask)
+        position = np.asarray(self.fluid.getFieldBuffer("position"))
+        kept = position[:total][mask].copy()
+        position[:count] = kept
+        np.asarray(self.fluid.getFieldBuffer("position0"))[:count] = kept
         self.fluid.setNumActiveParticles0(count)
         self.fluid.reset()
-        return len(x) - count
+        return total - count
 
     def damp(self, factor: float) -> None:
         """Scale every particle's velocity (the settle phase)."""

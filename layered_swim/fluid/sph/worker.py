@@ -21,6 +21,7 @@ import numpy as np
 from layered_swim.fluid.backend import FluidError
 
 REPLY_TIMEOUT_S = 600.0     # no single request (scene build, settle, step) takes this long
+FILL_EXCESS = 0.25          # the block is filled this share of the depth above the surface
 
 
 def _serve(conn) -> None:
@@ -61,26 +62,28 @@ def _max_speed(solver) -> float:
 
 
 def _start(spec: dict, folder: Path, write_scene, solver_class, margin_radii: float):
-    """Build the scene, remove the water inside the boxes, let it settle around them at rest."""
+    """Build the scene, remove the water inside the boxes, let it settle around them at rest,
+    skim what stands above the surface, and let it settle again."""
     started = time.perf_counter()
-    scene = write_scene(folder / "scene", **spec["scene"])
-    solver = solver_class(str(scene), str(folder / "output"), spec["scene"]["boxes_half_m"],
-                          spec["scene"]["time_step_s"], spec["viscosity_m2_s"], spec["scene"]["particle_radius_m"])
+    scene = spec["scene"]
+    r, surface = scene["particle_radius_m"], spec["surface_z_m"]
+    # A block on a 2r grid settles to a level below its top (SPH packs it differently), so the
+    # block is filled higher and the excess above the surface is skimmed after a first settle.
+    depth = surface - scene["pool_min_m"][2]
+    path = write_scene(folder / "scene", fill_top_z_m=surface + FILL_EXCESS * depth + 2 * r, **scene)
+    solver = solver_class(str(path), str(folder / "output"), scene["boxes_half_m"], scene["time_step_s"],
+                          spec["viscosity_m2_s"], r)
     pos, quat = spec["pos_m"], spec["quat_xyzw"]
     solver.place(pos, quat)
-    removed = solver.remove_inside(pos, quat, margin_radii * spec["scene"]["particle_radius_m"])
+    removed = solver.remove_inside(pos, quat, margin_radii * r)
     build_s = time.perf_counter() - started
-    # Settle: the block of water starts on a grid with voids where the boxes were; damping takes
-    # the sloshing out (kilonewton spikes otherwise), then a free stretch lets it come to rest.
-    zero = np.zeros_like(pos)
-    steps = int(round(spec["settle_s"] / spec["scene"]["time_step_s"]))
-    damped = int(steps * spec["damped_share"])
-    force_n = np.zeros((steps, 3))
-    for k in range(steps):
-        if k < damped:
-            solver.damp(spec["damping_per_step"])
-        force, _, _ = solver.step(pos, quat, zero, zero)
-        force_n[k] = force.sum(axis=0)
+    # Settle: the block starts on a grid with voids where the boxes were; damping takes the
+    # sloshing out (kilonewton spikes otherwise), then a free stretch lets it come to rest.
+    steps = int(round(spec["settle_s"] / scene["time_step_s"]))
+    _settle(solver, pos, quat, steps // 2, steps // 2, spec["damping_per_step"])
+    removed += solver.remove_above(surface)
+    force_n = _settle(solver, pos, quat, steps - steps // 2, int(steps * spec["damped_share"]) - steps // 2,
+                      spec["damping_per_step"])
     tail = force_n[-max(1, steps // 5):, 2]
     info = {
         "fluid_particles": solver.particles, "boundary_particles": solver.boundary_particles,
@@ -90,6 +93,19 @@ def _start(spec: dict, folder: Path, write_scene, solver_class, margin_radii: fl
         "max_particle_speed_m_s": _max_speed(solver),
     }
     return solver, info
+
+
+def _settle(solver, pos, quat, steps: int, damped: int, damping: float) -> np.ndarray:
+    """``steps`` steps around the boxes held still, the first ``damped`` with the water's
+    velocities scaled by ``damping`` each step; the total force on the boxes per step."""
+    zero = np.zeros_like(pos)
+    force_n = np.zeros((steps, 3))
+    for k in range(steps):
+        if k < damped:
+            solver.damp(damping)
+        force, _, _ = solver.step(pos, quat, zero, zero)
+        force_n[k] = force.sum(axis=0)
+    return force_n
 
 
 class SphWorker:
