@@ -40,8 +40,9 @@ def _serve(conn) -> None:
             if command == "start":
                 solver, reply = _start(payload, Path(folder.name), write_scene, SphSolver, INSIDE_MARGIN_RADII)
             elif command == "step":
-                force, torque, solver_s = solver.step(*payload)
-                reply = (force, torque, solver_s, solver.flow_at(payload[0]), _max_speed(solver))
+                *state, want_flow = payload
+                force, torque, solver_s = solver.step(*state)
+                reply = (force, torque, solver_s, solver.flow_at(state[0]) if want_flow else None, _max_speed(solver))
             elif command == "particles":
                 reply = (solver.positions().copy(), solver.velocities().copy())
             elif command == "stop":
