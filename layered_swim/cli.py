@@ -133,6 +133,7 @@ def _backend_option(command: argparse.ArgumentParser, pool: str | None = "small"
     if pool:
         sph.add_argument("--pool", choices=("small", "large"), default=pool,
                          help=f"SWIM's pool: small 3 x 1.5 x 0.5 m, large 5 x 2 x 0.7 m (default {pool})")
+    sph.add_argument("--water-depth", type=float, metavar="M", help="the pool's water depth (default: the pool's)")
     sph.add_argument("--particle-radius", type=float, default=0.025, metavar="M", help="default 0.025 m")
     sph.add_argument("--threads", type=int, metavar="N", help="solver threads (default: every core)")
     sph.add_argument("--deterministic", action="store_true", help="one solver thread: bit-identical runs")
@@ -144,8 +145,8 @@ def _fluid_settings(args):
         return None
     from layered_swim.runs import sph_settings_for
 
-    return sph_settings_for(args.pool, particle_radius_m=args.particle_radius, threads=args.threads,
-                            deterministic=args.deterministic)
+    return sph_settings_for(args.pool, args.water_depth, particle_radius_m=args.particle_radius,
+                            threads=args.threads, deterministic=args.deterministic)
 
 
 def _current_option(command: argparse.ArgumentParser) -> None:

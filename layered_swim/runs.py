@@ -187,12 +187,14 @@ def goal_run(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layer
             "fluid_backend": backend, **mean, "goals": per_goal, "swim_published": bench.SWIM_PUBLISHED.get(pool_name)}
 
 
-def sph_settings_for(pool_name: str, **options):
-    """SPH settings whose pool is SWIM's pool ``pool_name`` (length, width, water depth)."""
+def sph_settings_for(pool_name: str, water_depth_m: float | None = None, **options):
+    """SPH settings whose pool is SWIM's pool ``pool_name`` (length, width and, unless given,
+    water depth)."""
     from layered_swim.fluid.sph import SphSettings
 
     pool = bench.pool(pool_name)
-    return SphSettings(pool_size_m=(pool.length_m, pool.width_m, pool.depth_m), **options)
+    depth = pool.depth_m if water_depth_m is None else water_depth_m
+    return SphSettings(pool_size_m=(pool.length_m, pool.width_m, depth), **options)
 
 
 def fluid_report(episode: Episode) -> dict:

@@ -150,3 +150,16 @@ def test_water_colours_run_from_faint_blue_to_opaque_white():
     np.testing.assert_allclose(colours[2], [1.0, 1.0, 1.0, 1.0])
     np.testing.assert_allclose(colours[3], colours[2])              # faster water is clipped
     assert np.all(np.diff(colours[:3, 3]) > 0)
+
+
+def test_a_swimmer_through_the_floor_or_out_of_the_pool_stops_the_run():
+    from dataclasses import replace
+
+    episode = Episode("breaststroke", backend="sph", fluid_settings=SphSettings(**COARSE))
+    fluid, state = episode.sim.fluid, episode.sim.state
+    fluid.place_pool(state)
+    with pytest.raises(FluidError, match="sank through the floor of the 0.5 m deep SPH pool"):
+        fluid._check_inside(replace(state, pos_m=state.pos_m - [0.0, 0.0, 2.0]))
+    with pytest.raises(FluidError, match="left the 3 x 1.5 m SPH pool"):
+        fluid._check_inside(replace(state, pos_m=state.pos_m + [5.0, 0.0, 0.0]))
+    episode.close()

@@ -66,7 +66,7 @@ class Tank:
     def step(self, pos_m, quat_xyzw, linvel_m_s) -> np.ndarray:
         """One step with the boxes at this pose and velocity; the total force on them (3,)."""
         pos, quat = np.atleast_2d(pos_m), np.atleast_2d(quat_xyzw)
-        force, _, _, _, max_speed = self.worker.request("step", (pos, quat, np.atleast_2d(linvel_m_s),
+        force, _, _, _, max_speed, _ = self.worker.request("step", (pos, quat, np.atleast_2d(linvel_m_s),
                                                                  np.zeros_like(pos), False))
         if not max_speed < MAX_WATER_SPEED_M_S:
             raise FluidError(f"the SPH water blew up (a particle at {max_speed:.3g} m/s)")

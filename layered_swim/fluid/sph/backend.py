@@ -24,6 +24,7 @@ from layered_swim.geometry import quat_rotate
 from layered_swim.state import BodyState
 
 MAX_WATER_SPEED_M_S = 30.0     # a particle faster than this: the fluid blew up
+MAX_ESCAPED_SHARE = 0.01       # more of the water than this outside the container: the pool has failed
 HEADROOM_M = 0.4               # container wall above the surface, so splashes stay in
 DAMPING_PER_STEP = 0.95        # the settle phase's velocity scaling per step...
 DAMPED_SHARE = 0.7             # ...over this share of it; the rest runs free
@@ -136,7 +137,7 @@ class SphBackend(FluidBackend):
         self._last_time_s = state.time_s
         self._check_inside(state)
         want_flow = self.steps % max(1, round(1.0 / (FLOW_HZ * self.sph_settings.time_step_s))) == 0
-        force, torque, solver_s, flow, max_speed = self._worker.request(
+        force, torque, solver_s, flow, max_speed, escaped = self._worker.request(
             "step", (state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s, want_flow))
         if flow is not None:
             self._flow = flow
@@ -150,11 +151,17 @@ class SphBackend(FluidBackend):
         if not (max_speed < MAX_WATER_SPEED_M_S and np.isfinite(force).all() and np.isfinite(torque).all()):
             raise FluidError(f"the SPH water blew up at t = {state.time_s:.3f} s (a particle at {max_speed:.3g} m/s); "
                              "try a smaller time step or particle radius")
+        if escaped > MAX_ESCAPED_SHARE:
+            raise FluidError(f"{100 * escaped:.0f} % of the SPH water left the pool by t = {state.time_s:.2f} s (pushed "
+                             "through a wall or the floor by the body); use a larger --pool")
         return FluidWrenches(force, torque, self._flow, None)
 
     def _check_inside(self, state: BodyState) -> None:
         lo, hi = self.pool_min_m, self.pool_max_m
         com = state.com_m
+        if com[2] < lo[2]:
+            raise FluidError(f"the swimmer sank through the floor of the {self.sph_settings.pool_size_m[2]:g} m deep "
+                             f"SPH pool at t = {state.time_s:.2f} s; use --pool large or a larger --water-depth")
         if not (lo[0] < com[0] < hi[0] and lo[1] < com[1] < hi[1]):
             raise FluidError(f"the swimmer left the {hi[0] - lo[0]:g} x {hi[1] - lo[1]:g} m SPH pool at "
                              f"t = {state.time_s:.2f} s (centre of mass at x = {com[0]:.2f}, y = {com[1]:.2f} m)")

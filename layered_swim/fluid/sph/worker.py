@@ -29,7 +29,7 @@ def _serve(conn) -> None:
     from layered_swim.fluid.sph.scene import write_scene
     from layered_swim.fluid.sph.solver import INSIDE_MARGIN_RADII, SphSolver
 
-    solver = None
+    solver = walls = None
     folder = tempfile.TemporaryDirectory(prefix="layered_swim_sph_")
     while True:
         try:
@@ -39,10 +39,14 @@ def _serve(conn) -> None:
         try:
             if command == "start":
                 solver, reply = _start(payload, Path(folder.name), write_scene, SphSolver, INSIDE_MARGIN_RADII)
+                scene = payload["scene"]
+                margin = 2 * scene["particle_radius_m"]
+                walls = (np.asarray(scene["pool_min_m"]) - margin, np.asarray(scene["pool_max_m"]) + margin)
             elif command == "step":
                 *state, want_flow = payload
                 force, torque, solver_s = solver.step(*state)
-                reply = (force, torque, solver_s, solver.flow_at(state[0]) if want_flow else None, _max_speed(solver))
+                reply = (force, torque, solver_s, solver.flow_at(state[0]) if want_flow else None,
+                         *_water_check(solver, *walls))
             elif command == "particles":
                 reply = (solver.positions().copy(), solver.velocities().copy())
             elif command == "stop":
@@ -60,6 +64,14 @@ def _serve(conn) -> None:
 def _max_speed(solver) -> float:
     v = solver.velocities()
     return float(np.sqrt(np.einsum("ij,ij->i", v, v).max())) if len(v) else 0.0
+
+
+def _water_check(solver, lo: np.ndarray, hi: np.ndarray) -> tuple[float, float]:
+    """The fastest particle's speed and the share of the water outside the container (a body
+    pushed through a wall or the floor can squeeze particles out, and they then fall forever)."""
+    x = solver.positions()
+    outside = np.count_nonzero(np.any((x < lo) | (x > hi), axis=1))
+    return _max_speed(solver), outside / max(1, len(x))
 
 
 def _start(spec: dict, folder: Path, write_scene, solver_class, margin_radii: float):
