@@ -13,6 +13,7 @@ import ctypes.util
 import time
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from layered_swim.geometry import quat_multiply
 
@@ -28,34 +29,6 @@ def import_sph():
     import pysplishsplash
     import pysplishsplash.Utilities  # noqa: F401  (registers the submodules)
     return pysplishsplash
-
-
-def _conjugate(q):
-    return np.array([-q[0], -q[1], -q[2], q[3]])
-
-
-def _matrix_to_quat(m) -> np.ndarray:
-    """Rotation matrix -> unit quaternion (x, y, z, w)."""
-    m = np.asarray(m, dtype=float)
-    w = np.sqrt(max(0.0, 1.0 + m[0, 0] + m[1, 1] + m[2, 2])) / 2
-    x = np.sqrt(max(0.0, 1.0 + m[0, 0] - m[1, 1] - m[2, 2])) / 2
-    y = np.sqrt(max(0.0, 1.0 - m[0, 0] + m[1, 1] - m[2, 2])) / 2
-    z = np.sqrt(max(0.0, 1.0 - m[0, 0] - m[1, 1] + m[2, 2])) / 2
-    x = np.copysign(x, m[2, 1] - m[1, 2])
-    y = np.copysign(y, m[0, 2] - m[2, 0])
-    z = np.copysign(z, m[1, 0] - m[0, 1])
-    q = np.array([x, y, z, w])
-    return q / np.linalg.norm(q)
-
-
-def _quat_matrix(q) -> np.ndarray:
-    """Unit quaternions (..., 4) (x, y, z, w) -> rotation matrices (..., 3, 3)."""
-    x, y, z, w = np.moveaxis(np.asarray(q, dtype=float), -1, 0)
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=-1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=-1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=-1),
-    ], axis=-2)
 
 
 class SphSolver:
@@ -86,9 +59,9 @@ class SphSolver:
         # constant offset read off at init (the boxes start unrotated in the scene).
         offset_inv, inertia = [], []
         for body in self.bodies:
-            principal = np.asarray(body.getRotation(), dtype=float)          # (x, y, z, w)
-            mesh = _matrix_to_quat(body.getWorldSpaceRotation())
-            offset_inv.append(_conjugate(quat_multiply(_conjugate(principal), mesh)))
+            principal = Rotation.from_quat(body.getRotation())               # (x, y, z, w), as PyBullet's
+            mesh = Rotation.from_matrix(np.asarray(body.getWorldSpaceRotation()))
+            offset_inv.append((principal.inv() * mesh).inv().as_quat())
             inertia.append(self._measure_inertia(body, principal))
         self._offset_inv, self._inertia_body = np.array(offset_inv), np.array(inertia)
         self.boundary_particles = sum(sim.getBoundaryModel(k).numberOfParticles()
@@ -111,7 +84,7 @@ class SphSolver:
             body.addTorque(list(np.eye(3)[k]))
             inverse[:, k] = np.asarray(body.getAngularVelocity()) / self.dt
         body.setAngularVelocity([0.0, 0.0, 0.0])
-        r = _quat_matrix(principal)
+        r = principal.as_matrix()
         return np.linalg.inv(r.T @ inverse @ r)
 
     # -- the water ----------------------------------------------------------------------------
@@ -162,7 +135,7 @@ class SphSolver:
         how many particles went."""
         x = self.positions().astype(float)
         keep = np.ones(len(x), dtype=bool)
-        rotations = _quat_matrix(quat_xyzw)
+        rotations = Rotation.from_quat(quat_xyzw).as_matrix()
         for k in range(len(self.bodies)):
             local = (x - pos_m[k]) @ rotations[k]     # world -> box frame
             keep &= ~np.all(np.abs(local) < self.half[k] + margin_m, axis=1)
@@ -216,7 +189,7 @@ class SphSolver:
         velocity = np.array([body.getVelocity() for body in self.bodies])
         spin = np.array([body.getAngularVelocity() for body in self.bodies])
         force = self.mass[:, None] * velocity / self.dt
-        r = _quat_matrix(quat_multiply(np.asarray(quat_xyzw, dtype=float), self._offset_inv))
+        r = Rotation.from_quat(quat_multiply(np.asarray(quat_xyzw, dtype=float), self._offset_inv)).as_matrix()
         # tau = I_w dw / dt with I_w = R I_principal R^T.
         local = np.einsum("nji,nj->ni", r, spin)
         torque = np.einsum("nij,nj->ni", r, np.einsum("nij,nj->ni", self._inertia_body, local)) / self.dt
