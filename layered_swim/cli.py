@@ -353,13 +353,18 @@ def _cmd_goal(args) -> None:
     from layered_swim.runs import goal_run
     from layered_swim.tasks.goal import GOAL_METRICS
 
-    result = goal_run(args.pool, args.stroke, _vector(args.current, "--current"), Layers.parse(args.layers),
-                      args.backend, _fluid_settings(args))
+    current, layers = _vector(args.current, "--current"), Layers.parse(args.layers)
+    result = goal_run(args.pool, args.stroke, current, layers, args.backend, _fluid_settings(args))
+    if args.backend != "plate":     # the same task on the plates, beside (seconds, against minutes)
+        plate = goal_run(args.pool, args.stroke, current, layers)
+        result["plate"] = {k: plate[k] for k in GOAL_METRICS}
     if args.json:
         print(json.dumps(result, allow_nan=False))
         return
     rows = [[f"goal y={g['goal_m'][1]:+.2f}"] + [f"{g[k]:.3f}" for k in GOAL_METRICS] for g in result["goals"]]
-    rows.append(["mean"] + [f"{result[k]:.3f}" for k in GOAL_METRICS])
+    rows.append([f"mean ({args.backend})"] + [f"{result[k]:.3f}" for k in GOAL_METRICS])
+    if "plate" in result:
+        rows.append(["mean (plate)"] + [f"{result['plate'][k]:.3f}" for k in GOAL_METRICS])
     print(_table(rows, ["", "Pos m", "Prog", "Dev m", "Roll deg"]))
 
 

@@ -163,3 +163,22 @@ def test_a_swimmer_through_the_floor_or_out_of_the_pool_stops_the_run():
     with pytest.raises(FluidError, match="left the 3 x 1.5 m SPH pool"):
         fluid._check_inside(replace(state, pos_m=state.pos_m + [5.0, 0.0, 0.0]))
     episode.close()
+
+
+def test_goal_on_sph_reports_the_plates_beside(monkeypatch, capsys):
+    import layered_swim.cli as cli
+    import layered_swim.runs as runs
+
+    backends = []
+
+    def goal_run(pool, stroke, current, layers, backend="plate", settings=None):
+        backends.append(backend)
+        pos = 0.1 if backend == "sph" else 0.2
+        return {"pos_m": pos, "prog": 0.5, "dev_m": 0.1, "roll_deg": 0.0,
+                "goals": [{"goal_m": [1.5, 0.0, -0.05], "pos_m": pos, "prog": 0.5, "dev_m": 0.1, "roll_deg": 0.0}]}
+
+    monkeypatch.setattr(runs, "goal_run", goal_run)
+    cli._cmd_goal(cli._parser().parse_args(["goal", "--backend", "sph", "--json"]))
+    result = json.loads(capsys.readouterr().out)
+    assert backends == ["sph", "plate"]
+    assert result["pos_m"] == 0.1 and result["plate"] == {"pos_m": 0.2, "prog": 0.5, "dev_m": 0.1, "roll_deg": 0.0}
