@@ -11,7 +11,6 @@ water inside the body is removed and the rest settles, damped, around the body h
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 
