@@ -24,7 +24,7 @@ from layered_swim.fluid.medium import Medium
 from layered_swim.fluid.plate import _plate_wrenches
 from layered_swim.fluid.sph import SphSettings
 from layered_swim.fluid.backend import FluidError
-from layered_swim.fluid.sph.backend import DAMPED_SHARE, DAMPING_PER_STEP, HEADROOM_M, MAX_WATER_SPEED_M_S
+from layered_swim.fluid.sph.backend import HEADROOM_M, MAX_WATER_SPEED_M_S, boundary_boxes, start_request
 from layered_swim.fluid.sph.worker import SphWorker
 
 WINDOW_S = 0.02
@@ -45,23 +45,14 @@ class Tank:
 
     def __init__(self, settings: SphSettings, medium: Medium, size_m, half_m, pos_m, quat_xyzw, shrink: bool,
                  gravity_m_s2: float = 9.81):
-        r = settings.particle_radius_m
-        half = np.atleast_2d(half_m)
-        self.half_m = np.maximum(half - settings.mesh_shrink_radii * r, half / 2) if shrink else half
+        self.half_m = boundary_boxes(half_m, settings) if shrink else np.atleast_2d(half_m)
         self.dt = settings.time_step_s
         length, width, depth = size_m
+        still = Medium(medium.rho_kg_m3, medium.eta_pa_s, surface_z_m=0.0)
         self.worker = SphWorker(settings.solver_threads)
-        viscosity = medium.eta_pa_s / medium.rho_kg_m3
-        self.startup = self.worker.request("start", {
-            "scene": {"pool_min_m": np.array([-length / 2, -width / 2, -depth]),
-                      "pool_max_m": np.array([length / 2, width / 2, HEADROOM_M]),
-                      "particle_radius_m": r, "time_step_s": self.dt,
-                      "density_kg_m3": medium.rho_kg_m3, "viscosity_m2_s": viscosity, "gravity_m_s2": gravity_m_s2,
-                      "boxes_half_m": self.half_m, "box_centres_m": np.atleast_2d(pos_m)},
-            "viscosity_m2_s": viscosity, "surface_z_m": 0.0, "pos_m": np.atleast_2d(pos_m),
-            "quat_xyzw": np.atleast_2d(quat_xyzw),
-            "settle_s": settings.settle_s, "damped_share": DAMPED_SHARE, "damping_per_step": DAMPING_PER_STEP,
-        })
+        self.startup = self.worker.request("start", start_request(
+            settings, still, gravity_m_s2, [-length / 2, -width / 2, -depth], [length / 2, width / 2, HEADROOM_M],
+            self.half_m, pos_m, quat_xyzw))
 
     def step(self, pos_m, quat_xyzw, linvel_m_s) -> np.ndarray:
         """One step with the boxes at this pose and velocity; the total force on them (3,)."""

@@ -40,9 +40,10 @@ class SphBackend(FluidBackend):
         self.sph_settings = settings or SphSettings()
         self._check_medium(medium)
         s = self.sph_settings
-        shrink = s.mesh_shrink_radii * s.particle_radius_m
-        # The correction for SPH's fluid-free skin; never below half the box (thin limbs stay boxes).
-        self.boundary_half_m = np.maximum(body.half_extents_m - shrink, body.half_extents_m / 2)
+        self.boundary_half_m = boundary_boxes(body.half_extents_m, s)
+        # Steps per force window and per flow sample: fixed by the step, counted against self.steps.
+        self._window_steps = max(1, round(WINDOW_S / s.time_step_s))
+        self._flow_steps = max(1, round(1.0 / (FLOW_HZ * s.time_step_s)))
         self._worker = None
         self._last_time_s: float | None = None
         self.startup: dict = {}
@@ -66,8 +67,7 @@ class SphBackend(FluidBackend):
 
     @property
     def viscosity_m2_s(self) -> float:
-        s = self.sph_settings
-        return s.viscosity_m2_s if s.viscosity_m2_s is not None else self.medium.eta_pa_s / self.medium.rho_kg_m3
+        return kinematic_viscosity(self.sph_settings, self.medium)
 
     def settings(self) -> dict:
         s = self.sph_settings
@@ -111,21 +111,11 @@ class SphBackend(FluidBackend):
     def _start(self, state: BodyState) -> None:
         from layered_swim.fluid.sph.worker import SphWorker
 
-        s = self.sph_settings
         self.place_pool(state)
-        self._worker = SphWorker(s.solver_threads)
-        self.startup = self._worker.request("start", {
-            "scene": {
-                "pool_min_m": self.pool_min_m, "pool_max_m": self.pool_max_m,
-                "particle_radius_m": s.particle_radius_m,
-                "time_step_s": s.time_step_s, "density_kg_m3": self.medium.rho_kg_m3,
-                "viscosity_m2_s": self.viscosity_m2_s, "gravity_m_s2": self.gravity_m_s2,
-                "boxes_half_m": self.boundary_half_m, "box_centres_m": state.pos_m.copy(),
-            },
-            "viscosity_m2_s": self.viscosity_m2_s, "surface_z_m": self.medium.surface_z_m,
-            "pos_m": state.pos_m.copy(), "quat_xyzw": state.quat_xyzw.copy(),
-            "settle_s": s.settle_s, "damped_share": DAMPED_SHARE, "damping_per_step": DAMPING_PER_STEP,
-        })
+        self._worker = SphWorker(self.sph_settings.solver_threads)
+        self.startup = self._worker.request("start", start_request(
+            self.sph_settings, self.medium, self.gravity_m_s2, self.pool_min_m, self.pool_max_m,
+            self.boundary_half_m, state.pos_m, state.quat_xyzw))
 
     def wrenches(self, state: BodyState) -> FluidWrenches:
         if self._worker is None:
@@ -135,7 +125,7 @@ class SphBackend(FluidBackend):
                              f"({state.time_s - self._last_time_s:.6g} s)")
         self._last_time_s = state.time_s
         self._check_inside(state)
-        want_flow = self.steps % max(1, round(1.0 / (FLOW_HZ * self.sph_settings.time_step_s))) == 0
+        want_flow = self.steps % self._flow_steps == 0
         force, torque, solver_s, flow, max_speed, escaped = self._worker.request(
             "step", (state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s, want_flow))
         if flow is not None:
@@ -143,9 +133,9 @@ class SphBackend(FluidBackend):
         self.solver_s += solver_s
         self.steps += 1
         self._window += force.sum(axis=0)
-        per_window = max(1, round(WINDOW_S / self.sph_settings.time_step_s))
-        if self.steps % per_window == 0:
-            self.peak_window_force_n = max(self.peak_window_force_n, float(np.linalg.norm(self._window)) / per_window)
+        if self.steps % self._window_steps == 0:
+            self.peak_window_force_n = max(self.peak_window_force_n,
+                                           float(np.linalg.norm(self._window)) / self._window_steps)
             self._window[:] = 0.0
         if not (max_speed < MAX_WATER_SPEED_M_S and np.isfinite(force).all() and np.isfinite(torque).all()):
             raise FluidError(f"the SPH water blew up at t = {state.time_s:.3f} s (a particle at {max_speed:.3g} m/s); "
@@ -182,6 +172,32 @@ class SphBackend(FluidBackend):
                 "steps": self.steps, "solver_s": round(self.solver_s, 3),
                 "steps_with_segment_outside_pool": self.outside_steps,
                 "peak_total_force_n": self.peak_window_force_n, "window_s": WINDOW_S}
+
+
+def kinematic_viscosity(settings: SphSettings, medium: Medium) -> float:
+    """The settings' viscosity, or the medium's (dynamic over density)."""
+    return settings.viscosity_m2_s if settings.viscosity_m2_s is not None else medium.eta_pa_s / medium.rho_kg_m3
+
+
+def boundary_boxes(half_m: np.ndarray, settings: SphSettings) -> np.ndarray:
+    """The boxes SPH sees: shrunk by ``mesh_shrink_radii`` particle radii per side, the correction
+    for SPH's fluid-free skin, but never below half the box (thin limbs stay boxes)."""
+    half = np.atleast_2d(half_m)
+    return np.maximum(half - settings.mesh_shrink_radii * settings.particle_radius_m, half / 2)
+
+
+def start_request(settings: SphSettings, medium: Medium, gravity_m_s2: float, pool_min_m, pool_max_m,
+                  boxes_half_m, pos_m, quat_xyzw) -> dict:
+    """The worker's ``start`` request: the scene (pool, water, boxes) and how to settle it."""
+    pos, quat = np.array(np.atleast_2d(pos_m), dtype=float), np.array(np.atleast_2d(quat_xyzw), dtype=float)
+    return {
+        "scene": {"pool_min_m": np.asarray(pool_min_m, float), "pool_max_m": np.asarray(pool_max_m, float),
+                  "particle_radius_m": settings.particle_radius_m, "time_step_s": settings.time_step_s,
+                  "density_kg_m3": medium.rho_kg_m3, "viscosity_m2_s": kinematic_viscosity(settings, medium),
+                  "gravity_m_s2": gravity_m_s2, "boxes_half_m": np.atleast_2d(boxes_half_m), "box_centres_m": pos},
+        "surface_z_m": medium.surface_z_m, "pos_m": pos, "quat_xyzw": quat, "settle_s": settings.settle_s,
+        "damped_share": DAMPED_SHARE, "damping_per_step": DAMPING_PER_STEP,
+    }
 
 
 def body_corners(pos_m: np.ndarray, quat_xyzw: np.ndarray, half_m: np.ndarray) -> np.ndarray:

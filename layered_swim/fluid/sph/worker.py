@@ -85,7 +85,7 @@ def _start(spec: dict, folder: Path, write_scene, solver_class, margin_radii: fl
     depth = surface - scene["pool_min_m"][2]
     path = write_scene(folder / "scene", fill_top_z_m=surface + FILL_EXCESS * depth + 2 * r, **scene)
     solver = solver_class(str(path), str(folder / "output"), scene["boxes_half_m"], scene["time_step_s"],
-                          spec["viscosity_m2_s"], r)
+                          scene["viscosity_m2_s"], r)
     pos, quat = spec["pos_m"], spec["quat_xyzw"]
     solver.place(pos, quat)
     removed = solver.remove_inside(pos, quat, margin_radii * r)
