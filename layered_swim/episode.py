@@ -62,7 +62,11 @@ class Episode:
         config = SimConfig(physics_hz=physics_hz)
         fluid = make_fluid(backend, self.body, medium, config.gravity_m_s2, fluid_settings)
         self.sim = Simulation(self.body, controller, fluid, config, layout, self.stroke.pd_gain_scale)
-        self.reset(seed)
+        try:
+            self.reset(seed)
+        except BaseException:
+            self.close()
+            raise
 
     @property
     def controller(self):

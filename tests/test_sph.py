@@ -35,10 +35,8 @@ def test_bad_settings_are_one_line(field, value, message):
 
 
 def test_a_pool_smaller_than_the_swimmer_is_refused():
-    episode = Episode("breaststroke", backend="sph", fluid_settings=SphSettings(pool_size_m=(1.0, 1.0, 0.5), **COARSE))
     with pytest.raises(ConfigError, match="does not fit the 1 x 1 m SPH pool"):
-        episode.run(steps=1)
-    episode.close()
+        Episode("breaststroke", backend="sph", fluid_settings=SphSettings(pool_size_m=(1.0, 1.0, 0.5), **COARSE))
 
 
 def test_without_the_extra_the_backend_says_how_to_install(monkeypatch):
@@ -163,6 +161,34 @@ def test_a_swimmer_through_the_floor_or_out_of_the_pool_stops_the_run():
     with pytest.raises(FluidError, match="left the 3 x 1.5 m SPH pool"):
         fluid._check_inside(replace(state, pos_m=state.pos_m + [5.0, 0.0, 0.0]))
     episode.close()
+
+
+def test_the_pool_floor_holds_the_swimmer_and_a_deep_start_pose_is_raised_above_it():
+    from layered_swim.fluid.sph.backend import FLOOR_CLEARANCE_RADII, body_corners
+    from layered_swim.sim.world import World
+
+    episode = Episode("breaststroke", backend="sph", fluid_settings=SphSettings(**COARSE))
+    sim = episode.sim
+    floor_z = sim.fluid.pool_min_m[2]
+    lowest = body_corners(sim.state.pos_m, sim.state.quat_xyzw, sim.body.half_extents_m)[:, 2].min()
+    assert lowest == pytest.approx(floor_z + FLOOR_CLEARANCE_RADII * COARSE["particle_radius_m"])      # breaststroke's legs reach below 0.5 m
+    assert sim.fluid.startup["start_raised_m"] > 0
+    episode.close()
+    assert Episode("breaststroke").sim.fluid.container(sim.state) is None   # open water for the plates
+
+    # A limp body dropped in air onto the floor comes to rest on it, not through it.
+    world = World(sim.body, sim.layout, 480)
+    world.reset((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), sim.layout.zeros())
+    world.set_pool((-2.0, -2.0, -1.5), (2.0, 2.0, 0.5))
+    for _ in range(960):
+        world.step()
+    state = world.read_state()
+    assert body_corners(state.pos_m, state.quat_xyzw, sim.body.half_extents_m)[:, 2].min() > -1.55
+    world.set_pool(None, None)                                       # open water again: it falls through
+    for _ in range(480):
+        world.step()
+    assert world.read_state().pos_m[:, 2].max() < -1.6
+    world.close()
 
 
 def test_goal_on_sph_reports_the_plates_beside(monkeypatch, capsys):

@@ -63,6 +63,11 @@ class FluidBackend:
         ``state``; None where the water has no walls (the plates)."""
         return None
 
+    def container(self, state: BodyState) -> tuple[np.ndarray, np.ndarray, float] | None:
+        """Walls the body touches for a swim starting at ``state``: the box's lower and upper corner,
+        and how far the start must rise for its lowest point to clear the floor; None in open water."""
+        return None
+
     def particles(self) -> tuple[np.ndarray, np.ndarray] | None:
         """Water to draw: particle positions (k, 3) and speeds (k,); None where the model has none."""
         return None

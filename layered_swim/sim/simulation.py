@@ -100,7 +100,12 @@ class Simulation:
         self.controller.reset()
         self.fluid.reset()
         pose, _ = self.controller.desired(0.0, None, None)  # the stroke's pose at phase 0 needs no state
-        self.world.reset((*start.position_xy_m, -start.depth_m), quat, pose, velocity)
+        root_m = np.array([*start.position_xy_m, -start.depth_m])
+        self.world.reset(root_m, quat, pose, velocity)
+        pool = self.fluid.container(self.world.read_state())
+        if pool is not None and pool[2] > 0.0:
+            self.world.reset(root_m + [0.0, 0.0, pool[2]], quat, pose, velocity)
+        self.world.set_pool(*(pool[:2] if pool is not None else (None, None)))
         self.steps = 0
         self.external_force_n = None
         self.fluid_now = _still(len(self.body.segment_names))

@@ -152,6 +152,7 @@ class World:
         self._target_qd = np.zeros(tree.n_dof)
         self._torque = np.zeros(tree.n_dof)
         self._pending: np.ndarray | None = None   # generalised forces for the next step: PD and wrenches
+        self._walls: list[int] = []                # static bodies of a pool the swimmer touches
 
     # --- state -------------------------------------------------------------------------
     def reset(self, root_pos_m, root_quat_xyzw, pose: np.ndarray, root_linvel_m_s=(0.0, 0.0, 0.0)) -> None:
@@ -168,6 +169,35 @@ class World:
         self._torque[:] = 0.0
         self._pending = None
         self._fresh = False
+
+    def set_pool(self, min_m, max_m, thickness_m: float = 0.1) -> None:
+        """A floor and four walls on the faces of the box ``[min_m, max_m]`` that the swimmer
+        touches (an SPH pool: water the body pushed through them would leave it); open water
+        again when ``min_m`` is None."""
+        c = self.client
+        for uid in self._walls:
+            c.removeBody(uid)
+        self._walls = []
+        touching = min_m is not None
+        for link in [-1, *self._joints]:
+            c.setCollisionFilterGroupMask(self.uid, link, int(touching), 2 * int(touching))
+        if not touching:
+            return
+        lo, hi = np.asarray(min_m, float), np.asarray(max_m, float)
+        centre, half = (lo + hi) / 2, (hi - lo) / 2
+        slabs = [(centre - [0, 0, half[2] + thickness_m / 2], [half[0] + thickness_m, half[1] + thickness_m,
+                                                               thickness_m / 2])]
+        for axis in (0, 1):
+            for side in (-1, 1):
+                offset, extent = np.zeros(3), half + thickness_m
+                offset[axis] = side * (half[axis] + thickness_m / 2)
+                extent[axis] = thickness_m / 2
+                slabs.append((centre + offset, extent))
+        for at, extent in slabs:
+            shape = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=list(extent))
+            uid = c.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=shape, basePosition=list(at))
+            c.setCollisionFilterGroupMask(uid, -1, 2, 1)
+            self._walls.append(uid)
 
     @property
     def time_s(self) -> float:

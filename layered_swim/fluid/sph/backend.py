@@ -24,6 +24,8 @@ from layered_swim.state import BodyState
 
 MAX_WATER_SPEED_M_S = 30.0     # a particle faster than this: the fluid blew up
 MAX_ESCAPED_SHARE = 0.01       # more of the water than this outside the container: the pool has failed
+FLOOR_CLEARANCE_RADII = 3     # a start pose reaching below the floor is raised to clear it by this many
+                              # particle radii: closer, the settling water is squeezed between body and floor
 HEADROOM_M = 0.4               # container wall above the surface, so splashes stay in
 DAMPING_PER_STEP = 0.95        # the settle phase's velocity scaling per step...
 DAMPED_SHARE = 0.7             # ...over this share of it; the rest runs free
@@ -79,6 +81,7 @@ class SphBackend(FluidBackend):
     def reset(self) -> None:
         self.close()
         self._last_time_s = self.pool_min_m = self.pool_max_m = None
+        self.startup = {}
         self.solver_s, self.steps, self.outside_steps, self.peak_window_force_n = 0.0, 0, 0, 0.0
         self._window = np.zeros(3)
         self._flow = np.zeros_like(self._flow)
@@ -103,6 +106,18 @@ class SphBackend(FluidBackend):
         self.pool_min_m = np.array([back, centre_y - width / 2, surface - depth])
         self.pool_max_m = np.array([back + length, centre_y + width / 2, surface + HEADROOM_M])
 
+    def container(self, state: BodyState) -> tuple[np.ndarray, np.ndarray, float]:
+        """The pool's floor and walls (the swimmer touches them, as in a real pool: a body pushed
+        through SPH's walls would squeeze the water out), and the rise that lifts a start pose
+        reaching below the floor clear of it (the 0.5 m small pool is shallower than a
+        breaststroke's legs at rest)."""
+        self.place_pool(state)
+        lowest = body_corners(state.pos_m, state.quat_xyzw, self.body.half_extents_m)[:, 2].min()
+        clearance = FLOOR_CLEARANCE_RADII * self.sph_settings.particle_radius_m
+        lift = max(0.0, self.pool_min_m[2] + clearance - lowest)
+        self.startup = {"start_raised_m": round(float(lift), 4)}
+        return self.pool_min_m, self.pool_max_m, lift
+
     def domain_xy_m(self, state: BodyState) -> tuple[np.ndarray, np.ndarray]:
         if self.pool_min_m is None:
             self.place_pool(state)
@@ -111,11 +126,12 @@ class SphBackend(FluidBackend):
     def _start(self, state: BodyState) -> None:
         from layered_swim.fluid.sph.worker import SphWorker
 
-        self.place_pool(state)
+        if self.pool_min_m is None:
+            self.place_pool(state)
         self._worker = SphWorker(self.sph_settings.solver_threads)
-        self.startup = self._worker.request("start", start_request(
+        self.startup = {**self.startup, **self._worker.request("start", start_request(
             self.sph_settings, self.medium, self.gravity_m_s2, self.pool_min_m, self.pool_max_m,
-            self.boundary_half_m, state.pos_m, state.quat_xyzw))
+            self.boundary_half_m, state.pos_m, state.quat_xyzw))}
 
     def wrenches(self, state: BodyState) -> FluidWrenches:
         if self._worker is None:
