@@ -10,10 +10,22 @@ import json
 from dataclasses import asdict
 import math
 import os
+import re
 import sys
 from pathlib import Path
 
 PROG = "layered-swim"
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors, and values like ``-5,0,5`` taken as values, not options."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
 
 
 def _guard_stdout() -> None:
@@ -29,13 +41,14 @@ def _guard_stdout() -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog=PROG, description="A physically simulated human swimmer.")
+    p = _Parser(prog=PROG, description="A physically simulated human swimmer.")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     run = sub.add_parser("run", help="swim a stroke headless and write summary, log and config")
     run.add_argument("--stroke", required=True, help="stroke name (see `strokes`) or path to a stroke .yaml")
     run.add_argument("--seconds", type=float, default=30.0, help="simulated seconds (default 30)")
     run.add_argument("--out", help="output folder (default runs/<stroke>-<timestamp>)")
+    _overwrite_option(run)
     run.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     run.add_argument("--lung-volume", type=float, dest="lung_air_l", metavar="L",
                      help="inhaled air in litres, on top of the residual volume (default 3)")
@@ -62,6 +75,7 @@ def _parser() -> argparse.ArgumentParser:
     steering_options(follow)
     follow.add_argument("--seconds", type=float, default=60.0)
     follow.add_argument("--out", help="output folder (default runs/follow-<trajectory>-<timestamp>)")
+    _overwrite_option(follow)
     follow.add_argument("--json", action="store_true")
     _backend_option(follow, pool="large")       # a trajectory's target starts 2 m ahead
 
@@ -75,6 +89,7 @@ def _parser() -> argparse.ArgumentParser:
     render = sub.add_parser("render", help="draw a run folder or a trajectory swim to a video or PNG frames, no display needed")
     render.add_argument("source", help="a folder written by `run`/`follow --out` (replayed), or a trajectory (swum now)")
     render.add_argument("--out", required=True, help="video.mp4 (needs the video extra; else PNG frames) or a folder for PNGs")
+    _overwrite_option(render)
     render.add_argument("--seconds", type=float, help="length (default: the whole run, or 20 s of a trajectory)")
     render.add_argument("--fps", type=float, default=30.0)
     render.add_argument("--size", default="960x540", metavar="WxH")
@@ -95,6 +110,7 @@ def _parser() -> argparse.ArgumentParser:
         _current_option(command)
         command.add_argument("--json", action="store_true", help="print the summary as one JSON object")
         _backend_option(command)
+        _overwrite_option(command)
     analyze.add_argument("--out", help="output folder (default runs/analyze-<stroke>-<timestamp>)")
     compare.add_argument("--out", help="output folder (default runs/compare-<timestamp>)")
     _parallel_options(compare)
@@ -102,6 +118,7 @@ def _parser() -> argparse.ArgumentParser:
     experiment = sub.add_parser("experiment", help="reproduce one of the papers' experiments (figure + CSV + report)")
     experiment.add_argument("name", help="experiment name; `layered-swim experiment list` lists them")
     experiment.add_argument("--out", help="output folder (default runs/experiment-<name>)")
+    _overwrite_option(experiment)
     experiment.add_argument("--quick", action="store_true", help="fewer and shorter runs, for a first look")
     _parallel_options(experiment)
     experiment.add_argument("--seed", type=int, default=0, help="seed of the random pushes (perturbation)")
@@ -115,12 +132,26 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _overwrite_option(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--overwrite", action="store_true",
+                         help="empty an output folder that holds something else first (default: refuse)")
+
+
+def _out_dir(args, default: Path) -> Path:
+    """The command's output folder, checked before any work (``layered_swim.outputs``)."""
+    from layered_swim.outputs import prepare_out_dir
+
+    return prepare_out_dir(args.out or default, args.command, args.overwrite)
+
+
 def _water_options(command: argparse.ArgumentParser) -> None:
     """Density or fluid preset, seed and physics rate: the options of a single swim."""
     fluid = command.add_mutually_exclusive_group()
     fluid.add_argument("--density", type=float, metavar="KG_M3", help="water density (fresh water's viscosity)")
     fluid.add_argument("--fluid", choices=("fresh_water", "seawater"), default="fresh_water")
-    command.add_argument("--seed", type=int, default=0)
+    command.add_argument("--seed", type=int, default=0,
+                         help="0 (default): the stroke's exact start; any other: a start jittered by it "
+                              "(heading, speed, depth, pose; see README)")
     command.add_argument("--physics-hz", type=int, default=480)
 
 
@@ -184,7 +215,7 @@ def _fmt(value) -> str:
 def _cmd_run(args) -> None:
     from layered_swim.runs import default_out_dir, run_swim
 
-    out_dir = args.out or default_out_dir(args.stroke)
+    out_dir = _out_dir(args, default_out_dir(args.stroke))
     result = run_swim(args.stroke, args.seconds, args.lung_air_l, args.density, out_dir, args.seed,
                       args.physics_hz, args.tempo, fluid=args.fluid, progress=not args.json and sys.stderr.isatty(),
                       backend=args.backend, fluid_settings=_fluid_settings(args))
@@ -336,7 +367,7 @@ def _cmd_follow(args) -> None:
     from layered_swim.control.layered import Layers
     from layered_swim.runs import default_out_dir, follow_run
 
-    out = args.out or str(default_out_dir(f"follow-{Path(args.trajectory).stem}"))
+    out = str(_out_dir(args, default_out_dir(f"follow-{Path(args.trajectory).stem}")))
     result = follow_run(args.trajectory, args.stroke, Layers.parse(args.layers), _vector(args.current, "--current"),
                         args.density, args.seconds, out, args.backend, _fluid_settings(args))
     if args.json:
@@ -374,7 +405,8 @@ def _cmd_render(args) -> None:
 
     result = render(args.source, args.out, args.seconds, args.fps, _size(args.size), args.stroke, Layers.parse(args.layers),
                     _vector(args.current, "--current"), args.density, args.forces,
-                    progress=_progress(args), backend=args.backend, fluid_settings=_fluid_settings(args))
+                    progress=_progress(args), backend=args.backend, fluid_settings=_fluid_settings(args),
+                    overwrite=args.overwrite)
     if not result["video"] and Path(args.out).suffix.lower() == ".mp4":
         print(f"{PROG}: note: {result['note']}", file=sys.stderr)
     print(f"wrote {result['frames']} frames to {result['out']}")
@@ -405,7 +437,7 @@ def _cmd_analyze(args) -> None:
     from layered_swim.runs import default_out_dir
 
     config = _analysis_config(args, args.stroke)
-    out = Path(args.out or default_out_dir(f"analyze-{Path(args.stroke).stem}"))
+    out = _out_dir(args, default_out_dir(f"analyze-{Path(args.stroke).stem}"))
     result = analyze_stroke(config, progress=not args.json and sys.stderr.isatty())
     files = write_analysis(result, out)
     if args.json:
@@ -424,7 +456,7 @@ def _cmd_compare(args) -> None:
     if not strokes or len(set(strokes)) != len(strokes):
         raise ConfigError(f"--strokes must name one or more different strokes, got '{args.strokes}'")
     configs = [_analysis_config(args, stroke) for stroke in strokes]
-    out = Path(args.out or default_out_dir("compare"))
+    out = _out_dir(args, default_out_dir("compare"))
     results = write_comparison(configs, out, args.workers, progress=_progress(args))
     if args.json:
         print(json.dumps({r["stroke"]: r["summary"] for r in results} | {"out_dir": str(out)}, allow_nan=False))
@@ -444,7 +476,7 @@ def _cmd_experiment(args) -> None:
         print(_table([[name, module.TITLE] for name, module in EXPERIMENTS.items()], ["experiment", "reproduces"]))
         return
     module = experiment(args.name)
-    out = Path(args.out or Path("runs") / f"experiment-{args.name}")
+    out = _out_dir(args, Path("runs") / f"experiment-{args.name}")
     summary = run_experiment(module, out, quick=args.quick, workers=args.workers,
                              progress=_progress(args), seed=args.seed)
     if args.json:

@@ -5,6 +5,7 @@ expected, so the CLI can print it and exit non-zero instead of showing a traceba
 """
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -34,14 +35,32 @@ class Vec3(Strict):
 Model = TypeVar("Model", bound=BaseModel)
 
 
-def load_yaml(path: str | Path) -> Any:
+def read_text(path: str | Path) -> str:
+    """A text file people edit or a run wrote, as UTF-8; any failure is one ConfigError."""
     path = Path(path)
     try:
-        text = path.read_text()
+        return path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ConfigError(f"{path}: file not found") from None
+    except IsADirectoryError:
+        raise ConfigError(f"{path}: is a folder, not a file") from None
     except OSError as err:
         raise ConfigError(f"{path}: cannot read ({err.strerror})") from None
+    except UnicodeDecodeError as err:
+        raise ConfigError(f"{path}: not UTF-8 text (byte {err.start})") from None
+
+
+def load_json(path: str | Path) -> Any:
+    text = read_text(path)
+    try:
+        return json.loads(text)
+    except ValueError as err:
+        raise ConfigError(f"{path}: not valid JSON ({err.msg if hasattr(err, 'msg') else err})") from None
+
+
+def load_yaml(path: str | Path) -> Any:
+    path = Path(path)
+    text = read_text(path)
     try:
         return yaml.safe_load(text)
     except yaml.YAMLError as err:

@@ -6,7 +6,8 @@ After dm_control's Physics / Task / Environment split and Gymnasium's ``reset(se
   name), the controller (from the task's target and the layers) and the simulation, once.
 - ``reset(seed, **options)`` asks the task where to start (it may move its target: a goal task
   takes ``goal=k``), resets the simulation there without rebuilding anything, and lets the task
-  take its first sample.
+  take its first sample. Seed 0 starts exactly where the task says; any other seed jitters that
+  start (``jittered_start``), the same way every time for the same seed.
 - ``step()`` runs one physics step and lets the task observe it; ``run(seconds)`` is the loop
   every command, the calibration, the experiments, the app and the bench go through, with
   ``observers`` (a recorder, a push, the app's trail) called after every step.
@@ -19,6 +20,7 @@ which layers are on; the per-cycle layer reads the stroke's calibration table).
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Callable, Iterable
 
 import numpy as np
@@ -37,7 +39,7 @@ from layered_swim.control.targets import Target
 from layered_swim.fluid import make_fluid
 from layered_swim.fluid.medium import Medium
 from layered_swim.sim.simulation import SimConfig, Simulation
-from layered_swim.state import BodyState
+from layered_swim.state import BodyState, Start
 from layered_swim.tasks import Task
 
 Observer = Callable[[Simulation], None]
@@ -80,8 +82,10 @@ class Episode:
         """A new episode: the task picks the start (``options`` go to it), the simulation resets
         there, the task takes its first sample. ``seed`` restarts the episode's random generator."""
         if seed is not None:
-            self.rng = np.random.default_rng(seed)
+            self.seed, self.rng = seed, np.random.default_rng(seed)
         start = self.task.reset(self, self.rng, **options)
+        if self.seed:
+            start = jittered_start(start, self.rng)
         self.sim.reset(start)
         self.task.observe(self.sim)
         return self.sim.state
@@ -119,6 +123,21 @@ class Episode:
 
     def close(self) -> None:
         self.sim.close()
+
+
+START_JITTER = {"heading_rad": math.radians(5.0), "position_m": 0.1, "depth_m": 0.03, "speed_share": 0.1}
+
+
+def jittered_start(start: Start, rng: np.random.Generator) -> Start:
+    """``start`` moved by uniform random amounts within ``START_JITTER``: what a non-zero seed
+    does, so runs with different seeds differ and one seed repeats exactly."""
+    j = START_JITTER
+    heading, speed, depth = rng.uniform(-1.0, 1.0, 3)
+    dx, dy = rng.uniform(-j["position_m"], j["position_m"], 2)
+    return replace(start, heading_rad=start.heading_rad + heading * j["heading_rad"],
+                   speed_m_s=start.speed_m_s * (1.0 + speed * j["speed_share"]),
+                   depth_m=max(0.0, start.depth_m + depth * j["depth_m"]),
+                   position_xy_m=(start.position_xy_m[0] + dx, start.position_xy_m[1] + dy))
 
 
 def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Layers, weights: WeightPolicy | None,

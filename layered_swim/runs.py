@@ -6,7 +6,6 @@ file), ``goal_run`` is ``goal`` (SWIM's benchmark: one episode reset onto each g
 """
 from __future__ import annotations
 
-import json
 import math
 import platform
 import time
@@ -23,7 +22,10 @@ from layered_swim.control.stroke import available_strokes
 from layered_swim.control.targets import load_trajectory
 from layered_swim.episode import Episode
 from layered_swim.fluid.medium import Medium, preset
-from layered_swim.recorder import DEFAULT_LOG_HZ, Recorder
+from layered_swim.fluid.backend import FluidError
+from layered_swim.outputs import COMMAND_KEY, atomic_path, write_json
+from layered_swim.recorder import DEFAULT_LOG_HZ, SPOOL_DIR, Recorder
+from layered_swim.sim.simulation import SimulationDiverged
 from layered_swim.tasks import FollowTarget, FreeSwim, GoalReaching, swim_benchmark as bench
 from layered_swim.tasks.goal import GOAL_METRICS
 
@@ -48,9 +50,10 @@ def package_version() -> str:
         return "unknown (not installed)"
 
 
-def resolved_config(episode: Episode, arguments: dict, log_hz: int) -> dict:
+def resolved_config(episode: Episode, arguments: dict, log_hz: int, command: str) -> dict:
     sim = episode.sim
     return {
+        COMMAND_KEY: command,
         "arguments": arguments,
         "stroke_file": episode.stroke.source,
         "stroke": episode.stroke_spec.model_dump(mode="json"),
@@ -117,16 +120,51 @@ def run_swim(stroke: str, seconds: float = 30.0, lung_air_l: float | None = None
                  "out_dir": str(out_dir), "seed": seed, "physics_hz": physics_hz, "tempo": tempo,
                  "fluid": fluid, "log_hz": log_hz, "backend": backend}
     check_seconds(seconds)
+    out_dir.mkdir(parents=True, exist_ok=True)
     episode = Episode(stroke, FreeSwim(sample_hz=log_hz), medium=make_medium(fluid, density), backend=backend,
                       fluid_settings=fluid_settings, lung_air_l=lung_air_l, physics_hz=physics_hz, tempo=tempo,
                       seed=seed)
-    recorder = record(episode, seconds, log_hz, progress)
-    result = {**episode.metrics(), **fluid_report(episode)}
-    out_dir.mkdir(parents=True, exist_ok=True)
+    write_json(out_dir / "config.json", resolved_config(episode, arguments, log_hz, "run"))
+    return logged_swim(episode, seconds, out_dir, log_hz, progress)
+
+
+def logged_swim(episode: Episode, seconds: float, out_dir: Path, log_hz: int = DEFAULT_LOG_HZ,
+                progress: bool = False, extra: dict | None = None) -> dict:
+    """``swim`` with its log streamed into ``out_dir`` (flat memory for any length); writes
+    ``log.npz``, ``timeseries.csv`` and ``summary.json`` (``extra`` first, then the task's
+    metrics and the fluid's report) and returns the summary. A run stopped early (Ctrl-C, a
+    blow-up) saves what it logged, marked ``partial`` in its summary, then stops the caller too."""
+    try:
+        recorder = Recorder(episode.sim, log_hz, spool_dir=out_dir / SPOOL_DIR)
+    except BaseException:
+        episode.close()
+        raise
+    stopped = None
+    try:
+        swim(episode, seconds, [recorder], progress)
+    except (KeyboardInterrupt, SimulationDiverged, FluidError) as err:
+        stopped = err
+    result = {**(extra or {}), **_metrics(episode, stopped), **fluid_report(episode)}
+    if stopped is not None:
+        reason = "interrupted" if isinstance(stopped, KeyboardInterrupt) else " ".join(str(stopped).split())
+        result["partial"] = {"stopped_at_s": episode.time_s, "of_s": seconds, "reason": reason}
+        if recorder.empty:
+            raise stopped
     recorder.save(out_dir)
     write_json(out_dir / "summary.json", result)
-    write_json(out_dir / "config.json", resolved_config(episode, arguments, log_hz))
+    if stopped is not None:
+        raise stopped
     return result
+
+
+def _metrics(episode: Episode, stopped: BaseException | None) -> dict:
+    """The task's metrics; a run stopped too early to have them gets none rather than a second error."""
+    if stopped is None:
+        return episode.metrics()
+    try:
+        return episode.metrics()
+    except (ValueError, IndexError, ZeroDivisionError, ConfigError):
+        return {}
 
 
 def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = Layers(), current=(0.0, 0.0, 0.0),
@@ -137,26 +175,26 @@ def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = L
     episode = Episode(stroke, FollowTarget(target), medium=make_medium(density_kg_m3=density, current_m_s=current),
                       layers=layers, backend=backend, fluid_settings=fluid_settings)
     check_path_in_pool(episode, target, seconds)
-    out = Path(out_dir) if out_dir is not None else None
-    if out is None:
+    head = {"trajectory": target.name, "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
+            "seconds": seconds}
+    if out_dir is None:
         swim(episode, seconds)
-    else:
-        out.mkdir(parents=True, exist_ok=True)
-        record(episode, seconds).save(out)
-    result = {"trajectory": target.name, "stroke": stroke, "layers": layers.describe(),
-              "current_m_s": list(current), "seconds": seconds, **episode.metrics(),
-              **fluid_report(episode)}
-    if out is not None:
-        np.savez_compressed(out / "track.npz", **episode.task.track())
-        write_json(out / "summary.json", result)
-        write_json(out / "config.json", {"trajectory": str(target.source), "trajectory_spec": _dump(target.spec),
+        return {**head, **episode.metrics(), **fluid_report(episode)}
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(out / "config.json", {"command": "follow", "trajectory": str(target.source),
+                                     "trajectory_spec": _dump(target.spec),
                                          "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
                                          "density_kg_m3": density, "seconds": seconds,
                                          "stroke_file": episode.stroke.source,
                                          "fluid_backend": {"name": episode.sim.fluid.name,
                                                            "settings": episode.sim.fluid.settings()},
                                          "cycles_per_s_at_tempo_1": 1.0 / episode.stroke.period_s})
-    return result
+    try:
+        return logged_swim(episode, seconds, out, extra=head)
+    finally:
+        with atomic_path(out / "track.npz") as tmp:
+            np.savez_compressed(tmp, **episode.task.track())
 
 
 def goal_episode(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layers = Layers(),
@@ -228,10 +266,6 @@ def check_path_in_pool(episode: Episode, target, seconds: float) -> None:
 def check_seconds(seconds: float) -> None:
     if not (math.isfinite(seconds) and MIN_SECONDS <= seconds <= MAX_SECONDS):
         raise ConfigError(f"seconds must be between {MIN_SECONDS:g} and {MAX_SECONDS:g}, got {seconds}")
-
-
-def write_json(path: Path, data) -> None:
-    path.write_text(json.dumps(data, indent=2, allow_nan=False) + "\n")
 
 
 def _dump(spec):

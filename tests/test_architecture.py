@@ -52,7 +52,8 @@ def test_rooms_import_only_downward():
         "config": set(), "geometry": set(), "state": {"geometry"},
         "body": base, "fluid": base | {"body"}, "sim": base | {"body", "fluid"},
         "control": base | {"body"}, "tasks": base | {"body", "control"},
-        "episode": base | {"body", "fluid", "sim", "control", "tasks"}, "recorder": base | {"tasks"},
+        "episode": base | {"body", "fluid", "sim", "control", "tasks"}, "recorder": base | {"tasks", "outputs"},
+            "outputs": {"config"},
     }
 
     def room(module: str) -> str:

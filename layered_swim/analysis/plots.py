@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from layered_swim.outputs import atomic_path
+
 import matplotlib
 
 matplotlib.use("Agg")                  # headless: files only, no display
@@ -25,7 +27,8 @@ def save(fig, path: str | Path) -> None:
     for ax in fig.axes:
         ax.grid(True, alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=DPI)
     plt.close(fig)
 
 

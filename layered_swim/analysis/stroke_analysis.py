@@ -22,7 +22,8 @@ from layered_swim.control.stroke import stroke_path
 from layered_swim.episode import Episode
 from layered_swim.fluid import make_fluid
 from layered_swim.fluid.sph import SphSettings
-from layered_swim.runs import check_seconds, make_medium, record, resolved_config, write_json
+from layered_swim.outputs import COMMAND_KEY, write_json, write_text
+from layered_swim.runs import check_seconds, make_medium, record, resolved_config
 
 ANALYSIS_LOG_HZ = 120      # ~100 samples per stroke cycle for the profiles
 PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_figure,
@@ -61,7 +62,7 @@ def analyze_stroke(config: dict, progress: bool = False) -> dict:
                                  if posture == "prone" and towed is not None else None)
     summary["nominal_stroke_rate_cpm"] = 60.0 / stroke.period_s
     return {"stroke": stroke.name, "posture": posture, **result,
-            "config": resolved_config(episode, config, ANALYSIS_LOG_HZ)}
+            "config": resolved_config(episode, config, ANALYSIS_LOG_HZ, "analyze")}
 
 
 def comparisons(result: dict) -> list[dict]:
@@ -100,7 +101,7 @@ def write_analysis(result: dict, out_dir: str | Path) -> list[str]:
         for i in range(points)])
     for name, draw in PLOTS.items():
         draw(result, out / name)
-    (out / "report.md").write_text(report.analysis_report(result, table, list(PLOTS)))
+    write_text(out / "report.md", report.analysis_report(result, table, list(PLOTS)))
     return ["summary.json", "config.json", "cycles.csv", "profiles.csv", *PLOTS, "report.md"]
 
 
@@ -114,5 +115,6 @@ def write_comparison(configs: list[dict], out_dir: str | Path, workers: int = 2,
         write_analysis(result, out / result["stroke"])
         tables.append(comparisons(result))
     plots.compare_figure(results, out / "compare_profiles.png")
-    (out / "report.md").write_text(report.compare_report(results, tables, "compare_profiles.png"))
+    write_json(out / "config.json", {COMMAND_KEY: "compare", "analyses": configs})
+    write_text(out / "report.md", report.compare_report(results, tables, "compare_profiles.png"))
     return results

@@ -103,7 +103,7 @@ def analyze_log(log: dict, info: SwimmerInfo) -> dict:
     """Cycles, per-cycle rows, means and spreads, and mean +- SD profiles over the normalised
     cycle. ``log`` holds the recorder's arrays including ``joint_work_j``."""
     t = np.asarray(log["time_s"], dtype=float)
-    # Sample 0 has no fluid force yet (NaN): never part of the window, whatever the settle time.
+    # A row without a finite fluid force (the last of a run that blew up) is never part of the window.
     keep = (t >= info.settle_s) & np.isfinite(log["fluid_force_n"]).all(axis=(1, 2))
     window = {name: np.asarray(values)[keep] for name, values in log.items()}
     t = window["time_s"]

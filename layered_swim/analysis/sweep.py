@@ -13,11 +13,12 @@ from __future__ import annotations
 import hashlib
 import inspect
 import json
-import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from functools import lru_cache
 from pathlib import Path
 from typing import Callable
+
+from layered_swim.outputs import write_text
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 DEFAULT_WORKERS = 2     # the machines this project runs on have two cores
@@ -67,9 +68,7 @@ def _load(path: Path):
 
 def _store(path: Path, config: dict, result) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(json.dumps({"config": config, "result": result}, allow_nan=False))
-    tmp.replace(path)    # atomic: a reader never sees half a file
+    write_text(path, json.dumps({"config": config, "result": result}, allow_nan=False))   # whole or not at all
 
 
 def run_sweep(task: Callable[[dict], object], configs: list[dict], cache_dir: str | Path | None = None,

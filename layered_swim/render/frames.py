@@ -3,12 +3,16 @@ installed, otherwise numbered PNG frames; screenshots as PNG. Encoding runs on a
 thread so recording does not stall the window."""
 from __future__ import annotations
 
+import os
 import queue
+import shutil
 import threading
 from pathlib import Path
 
 import numpy as np
 from PIL import Image
+
+from layered_swim.config import ConfigError
 
 NO_ENCODER = "no MP4 encoder installed (pip install -e '.[video]' adds imageio-ffmpeg)"
 
@@ -29,10 +33,13 @@ def save_png(pixels: np.ndarray, path: Path) -> Path:
 
 
 class FrameWriter:
-    """``add`` frames, then ``close``. ``path`` ending in .mp4 asks for a video; without an encoder
-    (or for any other path) the frames go as PNGs into a folder, and ``note`` says which happened."""
+    """``add`` frames, then ``close`` (or ``abort``). ``path`` ending in .mp4 asks for a video;
+    without an encoder (or for any other path) the frames go as PNGs into a folder, and ``note``
+    says which happened. Frames go to a temporary name first and move into place on ``close``: a
+    failed render leaves nothing behind. A frame folder must be empty or hold only frames unless
+    ``overwrite``; a video file is replaced."""
 
-    def __init__(self, path: str | Path, fps: float):
+    def __init__(self, path: str | Path, fps: float, overwrite: bool = False):
         path = Path(path)
         self.fps = fps
         self.frames = 0
@@ -43,7 +50,10 @@ class FrameWriter:
         else:
             self.path = path
             self.note = f"writing {'MP4 video' if self.is_video else 'PNG frames'} to {path}"
-        (self.path.parent if self.is_video else self.path).mkdir(parents=True, exist_ok=True)
+        self._check_out(overwrite)
+        self._tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp{self.path.suffix}")
+        if not self.is_video:
+            self._tmp.mkdir()
         self._encoder = None
         self._queue: queue.Queue = queue.Queue(maxsize=120)
         self._error: Exception | None = None
@@ -63,7 +73,7 @@ class FrameWriter:
                 if self.is_video:
                     self._encode(pixels)
                 else:
-                    Image.fromarray(pixels).save(self.path / f"frame_{index:05d}.png")
+                    Image.fromarray(pixels).save(self._tmp / f"frame_{index:05d}.png")
         except Exception as err:  # reported to the caller on its next add() or close()
             self._error = err
             while self._queue.get() is not None:   # keep draining so add() never blocks forever
@@ -76,14 +86,47 @@ class FrameWriter:
         if self._encoder is None:
             import imageio_ffmpeg
             height, width = pixels.shape[:2]
-            self._encoder = imageio_ffmpeg.write_frames(str(self.path), (width, height), fps=self.fps, quality=7,
+            self._encoder = imageio_ffmpeg.write_frames(str(self._tmp), (width, height), fps=self.fps, quality=7,
                                                         macro_block_size=2, ffmpeg_log_level="error")
             self._encoder.send(None)
         self._encoder.send(np.ascontiguousarray(pixels).tobytes())
 
-    def close(self) -> Path:
+    def _check_out(self, overwrite: bool) -> None:
+        """Before any frame is drawn: the folder it goes into is writable, and the target is not
+        something else's (see the class)."""
+        if self.path.exists() and self.is_video == self.path.is_dir():
+            raise ConfigError(f"{self.path}: is a {'folder' if self.is_video else 'file'}; choose another --out")
+        if not self.is_video and self.path.is_dir() and not overwrite and not all(
+                f.is_file() and f.name.startswith("frame_") and f.suffix == ".png" for f in self.path.iterdir()):
+            raise ConfigError(f"{self.path}: holds files that are not rendered frames; choose another --out "
+                              "or add --overwrite to replace them")
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise ConfigError(f"{self.path.parent}: cannot create it ({err.strerror})") from None
+        if not os.access(self.path.parent, os.W_OK):
+            raise ConfigError(f"{self.path.parent}: cannot write there")
+
+    def _finish(self) -> None:
         self._queue.put(None)
         self._thread.join()
+
+    def close(self) -> Path:
+        """Finish encoding and move the frames into place."""
+        self._finish()
         if self._error is not None:
+            self.abort()
             raise OSError(f"{self.path}: {self._error}")
+        if not self.is_video and self.path.exists():
+            shutil.rmtree(self.path)
+        os.replace(self._tmp, self.path)
         return self.path
+
+    def abort(self) -> None:
+        """Stop and remove everything written."""
+        if self._thread.is_alive():
+            self._finish()
+        if self._tmp.is_dir():
+            shutil.rmtree(self._tmp, ignore_errors=True)
+        else:
+            self._tmp.unlink(missing_ok=True)

@@ -28,7 +28,7 @@ def frame_steps(frame: int, physics_hz: int, fps: float) -> int:
 def render(source: str, out: str | Path, seconds: float | None = None, fps: float = 30.0,
            size_px: tuple[int, int] = (960, 540), stroke: str = "breaststroke", layers: Layers = Layers(),
            current_m_s=(0.0, 0.0, 0.0), density_kg_m3: float | None = None, show_forces: bool = False,
-           progress: bool = False, backend: str = "plate", fluid_settings=None) -> dict:
+           progress: bool = False, backend: str = "plate", fluid_settings=None, overwrite: bool = False) -> dict:
     if not (math.isfinite(fps) and 1 <= fps <= 120):
         raise ConfigError(f"--fps must be between 1 and 120, got {fps}")
     width, height = size_px
@@ -41,7 +41,7 @@ def render(source: str, out: str | Path, seconds: float | None = None, fps: floa
     from layered_swim.render.renderer import Renderer, gl_config, read_pixels
 
     window = pyglet.window.Window(width, height, visible=False, config=gl_config())
-    writer = FrameWriter(out, fps)
+    writer = FrameWriter(out, fps, overwrite)
     try:
         count, total = next(frames)
         renderer = Renderer(count)
@@ -56,9 +56,12 @@ def render(source: str, out: str | Path, seconds: float | None = None, fps: floa
             renderer.draw(scene, camera, width, height, show_forces=show_forces)
             writer.add(read_pixels(width, height))
         renderer.delete()
+    except BaseException:
+        writer.abort()
+        raise
     finally:
-        path = writer.close()
         window.close()
+    path = writer.close()
     return {"out": str(path), "frames": writer.frames, "fps": fps, "video": writer.is_video, "note": writer.note}
 
 

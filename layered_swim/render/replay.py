@@ -2,14 +2,15 @@
 read back as a ``Scene`` at any time."""
 from __future__ import annotations
 
-import json
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from layered_swim.render.scene import Scene
 from layered_swim.body.model import load_body
-from layered_swim.config import ConfigError
+from layered_swim.config import ConfigError, load_json
+from layered_swim.recorder import read_log
 
 TRAIL_SECONDS = 60.0
 
@@ -17,26 +18,23 @@ TRAIL_SECONDS = 60.0
 class LogReplay:
     def __init__(self, run_dir: str | Path):
         run_dir = Path(run_dir)
-        log_path = run_dir / "log.npz"
-        if not log_path.exists():
-            raise ConfigError(f"{run_dir}: no log.npz (a folder written by `layered-swim run` or `follow --out`)")
-        with np.load(log_path) as log:
-            self.time_s = log["time_s"]
-            self.segment_pos_m = log["segment_pos_m"]
-            self.segment_quat_xyzw = log["segment_quat_xyzw"]
-            self.fluid_force_n = np.nan_to_num(log["fluid_force_n"])     # sample 0 has none yet
-            self.com_pos_m = log["com_pos_m"]
-            names = tuple(str(n) for n in log["segment_names"])
+        log = read_log(run_dir)
+        self.time_s = log["time_s"]
+        self.segment_pos_m = log["segment_pos_m"]
+        self.segment_quat_xyzw = log["segment_quat_xyzw"]
+        self.fluid_force_n = np.nan_to_num(log["fluid_force_n"])     # a blow-up's last row: draw no arrows
+        self.com_pos_m = log["com_pos_m"]
+        self.partial = bool(log["partial"])
+        names = tuple(str(n) for n in log["segment_names"])
         body = load_body()
         if names != tuple(body.segment_names):
-            raise ConfigError(f"{log_path}: its segments {names} are not this body's {tuple(body.segment_names)}")
+            raise ConfigError(f"{run_dir}: its log's segments {names} are not this body's {tuple(body.segment_names)}")
         self.segment_names, self.half_extents_m = names, body.half_extents_m
         self.target_time_s = self.target_m = None
         track_path = run_dir / "track.npz"
         if track_path.exists():
-            with np.load(track_path) as track:
-                self.target_time_s, self.target_m = track["track_time_s"], track["target_m"]
-        self.current_m_s = np.asarray(_current(run_dir / "config.json"), float)
+            self.target_time_s, self.target_m = _track(track_path)
+        self.current_m_s = _current(run_dir / "config.json")
 
     @property
     def duration_s(self) -> float:
@@ -54,9 +52,29 @@ class LogReplay:
                      target, None, self.com_pos_m[first:i + 1:stride], self.fluid_force_n[i], self.current_m_s)
 
 
-def _current(config_path: Path) -> list[float]:
+def _track(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    try:
+        with np.load(path, allow_pickle=False) as track:
+            time_s, target_m = track["track_time_s"], track["target_m"]
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as err:
+        raise ConfigError(f"{path}: not a readable target track ({type(err).__name__})") from None
+    if time_s.ndim != 1 or target_m.shape != (len(time_s), 3) or not np.isfinite(target_m).all():
+        raise ConfigError(f"{path}: expected track_time_s (n,) and finite target_m (n, 3)")
+    return time_s, target_m
+
+
+def _current(config_path: Path) -> np.ndarray:
     """The run's current: ``follow`` writes it at the top level, ``run`` inside its medium."""
     if not config_path.exists():
-        return [0.0, 0.0, 0.0]
-    config = json.loads(config_path.read_text())
-    return config.get("current_m_s") or config.get("medium", {}).get("current_m_s") or [0.0, 0.0, 0.0]
+        return np.zeros(3)
+    config = load_json(config_path)
+    medium = config.get("medium") if isinstance(config, dict) else None
+    current = (config.get("current_m_s") if isinstance(config, dict) else None) or \
+        (medium.get("current_m_s") if isinstance(medium, dict) else None) or [0.0, 0.0, 0.0]
+    try:
+        current = np.asarray(current, float)
+    except (TypeError, ValueError):
+        current = None
+    if current is None or current.shape != (3,) or not np.isfinite(current).all():
+        raise ConfigError(f"{config_path}: field 'current_m_s' must be three finite numbers")
+    return current

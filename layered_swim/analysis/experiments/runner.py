@@ -14,7 +14,8 @@ from pathlib import Path
 from layered_swim.analysis import report
 from layered_swim.analysis.sweep import run_sweep
 from layered_swim.config import ConfigError
-from layered_swim.runs import write_json, versions
+from layered_swim.outputs import COMMAND_KEY, write_json, write_text
+from layered_swim.runs import versions
 
 
 @dataclass(frozen=True)
@@ -34,11 +35,11 @@ def run_experiment(module, out_dir: str | Path, quick: bool = False, workers: in
     configs = module.configs(quick, seed)
     results = run_sweep(module.run, configs, out / "cache", workers, progress, desc=module.NAME)
     outcome = module.finish(configs, results, out)
-    write_json(out / "config.json", {"experiment": module.NAME, "quick": quick, "seed": seed, "runs": configs,
+    write_json(out / "config.json", {COMMAND_KEY: "experiment", "experiment": module.NAME, "quick": quick, "seed": seed, "runs": configs,
                                       "versions": versions()})
     summary = {"experiment": module.NAME, "title": module.TITLE, "paper": module.PAPER, "ours": outcome.ours,
                "differs": outcome.differs, "setting": outcome.setting, **outcome.numbers}
     write_json(out / "summary.json", summary)
-    (out / "report.md").write_text(report.experiment_report(module.TITLE, module.FIGURE, module.CSV, module.PAPER,
-                                                            outcome.ours, outcome.setting, outcome.differs))
+    write_text(out / "report.md", report.experiment_report(module.TITLE, module.FIGURE, module.CSV, module.PAPER,
+                                                           outcome.ours, outcome.setting, outcome.differs))
     return {**summary, "files": [module.FIGURE, module.CSV, "summary.json", "config.json", "report.md"]}
