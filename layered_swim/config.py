@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Annotated, Any, TypeVar
 
 import yaml
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 
 class ConfigError(Exception):
@@ -23,10 +23,22 @@ class Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
+def between(low: float, high: float, above: bool = False):
+    """A float people edit with its physical bounds: ``low`` (excluded with ``above``) to ``high``.
+    Every number in a file people edit has both, so a typo like 1e308 is an error, not a run."""
+    return Annotated[float, Field(gt=low, le=high) if above else Field(ge=low, le=high)]
+
+
+Degrees = between(-360.0, 360.0)
+Coordinate_m = between(-1e4, 1e4)        # anywhere in a 20 km square
+
+
 class Vec3(Strict):
-    x: float
-    y: float
-    z: float
+    """A body-scale vector (axes, offsets, sizes in m)."""
+
+    x: between(-10.0, 10.0)
+    y: between(-10.0, 10.0)
+    z: between(-10.0, 10.0)
 
     def as_tuple(self) -> tuple[float, float, float]:
         return (self.x, self.y, self.z)

@@ -32,6 +32,7 @@ import hashlib
 import json
 import shutil
 import zipfile
+import zlib
 from pathlib import Path
 from typing import Iterator, Mapping
 
@@ -201,6 +202,11 @@ def _spooled_chunks(folder: Path) -> Iterator[dict[str, np.ndarray]]:
             yield {name: chunk[name] for name in chunk.files}
 
 
+# What a damaged .npz can raise while being read (a bad zip, a bad deflate stream, a bad header).
+UNREADABLE_ARCHIVE = (OSError, ValueError, KeyError, EOFError, TypeError, NotImplementedError, zipfile.BadZipFile,
+                      zlib.error)
+
+
 def read_log(run_dir: str | Path) -> dict[str, np.ndarray]:
     """A run folder's log (``log.npz``, or the chunks a killed run left in ``log.partial/``),
     checked: every array present with consistent shapes, times increasing, positions finite.
@@ -222,7 +228,7 @@ def read_log(run_dir: str | Path) -> dict[str, np.ndarray]:
             log["partial"] = True
         else:
             raise ConfigError(f"{run_dir}: no log.npz (a folder written by `layered-swim run` or `follow --out`)")
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile, TypeError) as err:
+    except UNREADABLE_ARCHIVE as err:
         raise ConfigError(f"{path}: not a readable log ({_reason(err)})") from None
     _check_log(log, path)
     return log

@@ -12,9 +12,9 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from pydantic import PositiveFloat, NonNegativeFloat, field_validator, model_validator
+from pydantic import field_validator, model_validator
 
-from layered_swim.config import ConfigError, Strict, Vec3, load
+from layered_swim.config import ConfigError, Degrees, Strict, Vec3, between, load
 from layered_swim.state import Segments
 
 DEFAULT_BODY_FILE = resources.files("layered_swim.body") / "swimmer.yaml"
@@ -23,8 +23,8 @@ AXES_PER_JOINT_TYPE = {"ball": 3, "hinge": 1, "two_axis": 2}
 
 class JointAxisSpec(Strict):
     axis: Vec3
-    min_deg: float
-    max_deg: float
+    min_deg: Degrees
+    max_deg: Degrees
 
     @model_validator(mode="after")
     def _check(self) -> "JointAxisSpec":
@@ -36,9 +36,9 @@ class JointAxisSpec(Strict):
 
 
 class PDSpec(Strict):
-    kp: PositiveFloat
-    kd: NonNegativeFloat
-    max_torque_nm: PositiveFloat
+    kp: between(0.0, 1e5, above=True)
+    kd: between(0.0, 1e4)
+    max_torque_nm: between(0.0, 1e4, above=True)
 
 
 class JointSpec(Strict):
@@ -62,9 +62,12 @@ class SizeSpec(Vec3):
         return self
 
 
+Density = between(100.0, 5000.0)          # foam to stone, kg/m3
+
+
 class SegmentSpec(Strict):
-    mass_kg: PositiveFloat
-    density_kg_m3: PositiveFloat
+    mass_kg: between(0.0, 300.0, above=True)
+    density_kg_m3: Density
     size_m: SizeSpec
     parent: str | None = None
     joint: str | None = None
@@ -81,16 +84,16 @@ class SegmentSpec(Strict):
 
 class LungSpec(Strict):
     segment: str
-    residual_volume_l: NonNegativeFloat
-    default_air_l: NonNegativeFloat
+    residual_volume_l: between(0.0, 10.0)
+    default_air_l: between(0.0, 10.0)
 
 
 class BodySpec(Strict):
     name: str
-    total_mass_kg: PositiveFloat
-    mean_density_kg_m3: PositiveFloat
+    total_mass_kg: between(0.0, 500.0, above=True)
+    mean_density_kg_m3: Density
     lungs: LungSpec
-    gimbal_mass_kg: PositiveFloat
+    gimbal_mass_kg: between(0.0, 10.0, above=True)
     segments: dict[str, SegmentSpec]
     joints: dict[str, JointSpec]
 

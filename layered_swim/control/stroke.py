@@ -15,10 +15,10 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from pydantic import Field, PositiveFloat, model_validator
+from pydantic import Field
 from scipy.interpolate import PchipInterpolator
 
-from layered_swim.config import ConfigError, Strict, available_files, file_path, load
+from layered_swim.config import ConfigError, Degrees, Strict, available_files, between, file_path, load
 from layered_swim.control.steering import SteeringGains
 from layered_swim.state import JointLayout, Start
 
@@ -87,12 +87,12 @@ class SteeringSpec(Strict):
 class StrokeSpec(Strict):
     name: str
     description: str = ""
-    period_s: PositiveFloat
+    period_s: between(0.2, 20.0)                   # human stroke cycles take 0.6 to 3 s
     interpolation: Literal["smooth", "linear"] = "smooth"
     start: StartSpec = StartSpec()
-    rest_pose: dict[str, dict[str, float]] = {}
+    rest_pose: dict[str, dict[str, Degrees]] = {}
     keys: dict[str, JointKeys] = {}
-    pd_gain_scale: dict[str, PositiveFloat] = {}
+    pd_gain_scale: dict[str, between(0.01, 100.0)] = {}
     perturbations: dict[Sequence, PerturbationSpec] = {}
     rules: RulesSpec = RulesSpec()
     steering: SteeringSpec = SteeringSpec()
@@ -185,8 +185,8 @@ def _keyed_table(keys: dict[str, JointKeys], base: np.ndarray, layout: JointLayo
                 parsed = {float(t): float(v) for t, v in axis_keys.items()}
             except (TypeError, ValueError):
                 raise ConfigError(f"{where}.{axis}': keys and values must be numbers") from None
-            if not all(np.isfinite(list(parsed)) & np.isfinite(list(parsed.values()))):
-                raise ConfigError(f"{where}.{axis}': keys and values must be finite numbers")
+            if not all(np.isfinite(list(parsed)) & (np.abs(list(parsed.values())) <= 360.0)):
+                raise ConfigError(f"{where}.{axis}': keys must be finite and angles within +-360 degrees")
             table[:, k], rates[:, k] = _cyclic_curve(parsed, joint_keys.phase_shift, smooth, f"{where}.{axis}'")
     return CyclicTable(table, rates)
 

@@ -16,9 +16,9 @@ from pathlib import Path
 from typing import Any, Literal, Protocol, runtime_checkable
 
 import numpy as np
-from pydantic import Field, NonNegativeFloat, PositiveFloat
+from pydantic import Field
 
-from layered_swim.config import ConfigError, Strict, available_files, file_path, load_yaml, parse
+from layered_swim.config import ConfigError, Coordinate_m, Strict, available_files, between, file_path, load_yaml, parse
 
 TRAJECTORIES_DIR = Path(__file__).resolve().parents[2] / "trajectories"
 CURVE_SAMPLES = 4096          # samples per closed curve (figure eight, circle)
@@ -100,33 +100,38 @@ class TrajectoryTarget:
 
 # ---------------------------------------------------------------- file schemas
 
+Length_m = between(0.0, 1e4, above=True)
+Time_s = between(0.0, 1e5)            # a day at most
+Heading_deg = between(-3600.0, 3600.0)
+
+
 class Point2(Strict):
-    x: float
-    y: float
+    x: Coordinate_m
+    y: Coordinate_m
 
 
 class Size2(Strict):
-    x: PositiveFloat       # total width along x, m
-    y: PositiveFloat       # total height along y, m
+    x: Length_m            # total width along x, m
+    y: Length_m            # total height along y, m
 
 
 class Waypoint(Strict):
-    t_s: NonNegativeFloat
-    x: float
-    y: float
-    z: float               # height above the surface: a depth d is z = -d
+    t_s: Time_s
+    x: Coordinate_m
+    y: Coordinate_m
+    z: between(-100.0, 10.0)   # height above the surface: a depth d is z = -d (deepest 100 m)
 
 
 class _Common(Strict):
     name: str
     description: str = ""
     loop: bool = False
-    start_s: NonNegativeFloat = 0.0     # seconds along the path at time 0
+    start_s: Time_s = 0.0               # seconds along the path at time 0
 
 
 class _Curve(_Common):
-    speed_m_s: PositiveFloat
-    depth_m: NonNegativeFloat           # the whole curve lies at z = -depth_m
+    speed_m_s: between(0.0, 5.0, above=True)   # twice the fastest human swimmer
+    depth_m: between(0.0, 100.0)        # the whole curve lies at z = -depth_m
 
 
 class FigureEightSpec(_Curve):
@@ -139,26 +144,26 @@ class FigureEightSpec(_Curve):
 
 class CircleSpec(_Curve):
     type: Literal["circle"]
-    radius_m: PositiveFloat
+    radius_m: Length_m
     center_m: Point2
     counterclockwise: bool = True
-    start_angle_deg: float = -90.0      # where on the circle it starts, seen from the centre
+    start_angle_deg: Heading_deg = -90.0      # where on the circle it starts, seen from the centre
 
 
 class SinusoidSpec(_Curve):
     type: Literal["sinusoid"]
     start_m: Point2
-    heading_deg: float
-    length_m: PositiveFloat             # along the heading
-    amplitude_m: NonNegativeFloat       # to the left of the heading first
-    wavelength_m: PositiveFloat
+    heading_deg: Heading_deg
+    length_m: Length_m                  # along the heading
+    amplitude_m: between(0.0, 1e4)      # to the left of the heading first
+    wavelength_m: Length_m
 
 
 class LineSpec(_Curve):
     type: Literal["line"]
     start_m: Point2
-    heading_deg: float
-    length_m: PositiveFloat
+    heading_deg: Heading_deg
+    length_m: Length_m
 
 
 class PolylineSpec(_Common):
@@ -166,7 +171,7 @@ class PolylineSpec(_Common):
     the target returns from the last waypoint to the first over ``closing_s`` seconds."""
     type: Literal["polyline"]
     waypoints: list[Waypoint] = Field(min_length=2)
-    closing_s: PositiveFloat | None = None
+    closing_s: between(0.0, 1e5, above=True) | None = None
 
 
 SPECS: dict[str, type[Strict]] = {

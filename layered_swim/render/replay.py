@@ -2,7 +2,6 @@
 read back as a ``Scene`` at any time."""
 from __future__ import annotations
 
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -10,7 +9,7 @@ import numpy as np
 from layered_swim.render.scene import Scene
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, load_json
-from layered_swim.recorder import read_log
+from layered_swim.recorder import UNREADABLE_ARCHIVE, read_log
 
 TRAIL_SECONDS = 60.0
 
@@ -56,7 +55,7 @@ def _track(path: Path) -> tuple[np.ndarray, np.ndarray]:
     try:
         with np.load(path, allow_pickle=False) as track:
             time_s, target_m = track["track_time_s"], track["target_m"]
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as err:
+    except UNREADABLE_ARCHIVE as err:
         raise ConfigError(f"{path}: not a readable target track ({type(err).__name__})") from None
     if time_s.ndim != 1 or target_m.shape != (len(time_s), 3) or not np.isfinite(target_m).all():
         raise ConfigError(f"{path}: expected track_time_s (n,) and finite target_m (n, 3)")

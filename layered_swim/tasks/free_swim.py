@@ -1,10 +1,9 @@
 """Free swimming: the stroke on its own, no target; scored by the run's headline numbers."""
 from __future__ import annotations
 
-import numpy as np
 
 from layered_swim.state import Start
-from layered_swim.tasks.base import Task, moved_start
+from layered_swim.tasks.base import SampleLog, Task, moved_start
 from layered_swim.tasks.metrics import head_top_height_m, summary
 
 DEFAULT_SAMPLE_HZ = 60
@@ -24,23 +23,20 @@ class FreeSwim(Task):
         self._stroke, self._controller = episode.stroke.name, episode.sim.controller
         body = episode.body
         self._head_half_z_m = float(body.half_extents_m[body.index("head"), 2])
-        self._samples: dict[str, list] = {"time_s": [], "com_m": [], "pelvis_m": [], "thorax_quat": [], "head_pos_m": [],
-                                          "head_quat": []}
+        self._samples = SampleLog({"time_s": 1, "com_m": 3, "pelvis_m": 3, "thorax_quat": 4, "head_pos_m": 3,
+                                   "head_quat": 4})
         return moved_start(episode.stroke.start_state(), speed_m_s=self.speed_m_s)
 
     def observe(self, sim) -> None:
         if sim.steps % self._every:
             return
-        s, rows = sim.state, self._samples
-        rows["time_s"].append(sim.steps / sim.config.physics_hz)   # exact, unlike a running sum of dt
-        rows["com_m"].append(s.com_m)
-        rows["pelvis_m"].append(s.pos("pelvis"))
-        rows["thorax_quat"].append(s.quat("thorax"))
-        rows["head_pos_m"].append(s.pos("head"))
-        rows["head_quat"].append(s.quat("head"))
+        s = sim.state
+        self._samples.append(time_s=sim.steps / sim.config.physics_hz,   # exact, unlike a running sum of dt
+                             com_m=s.com_m, pelvis_m=s.pos("pelvis"), thorax_quat=s.quat("thorax"),
+                             head_pos_m=s.pos("head"), head_quat=s.quat("head"))
 
     def metrics(self) -> dict:
-        a = {name: np.array(rows, dtype=float) for name, rows in self._samples.items()}
+        a = self._samples.arrays()
         head_top = head_top_height_m(a["head_pos_m"], a["head_quat"], self._head_half_z_m)
         return summary(a["time_s"], a["com_m"], a["pelvis_m"], a["thorax_quat"], head_top,
                        self._controller.cycles_per_s, self._stroke)
