@@ -100,7 +100,9 @@ def _parser() -> argparse.ArgumentParser:
     _backend_option(render, pool="large")
 
     analyze = sub.add_parser("analyze", help="swim steadily and report per-cycle stroke metrics, plots and a report")
-    analyze.add_argument("--stroke", required=True, help="stroke name (see `strokes`) or path to a stroke .yaml")
+    what = analyze.add_mutually_exclusive_group(required=True)
+    what.add_argument("--stroke", help="stroke name (see `strokes`) or path to a stroke .yaml: swim it now")
+    what.add_argument("--run", metavar="DIR", help="analyze the log of a `run` folder instead (a stopped, partial one too)")
     compare = sub.add_parser("compare", help="analyze several strokes and report them side by side")
     compare.add_argument("--strokes", required=True, metavar="A,B,...", help="comma-separated stroke names")
     for command in (analyze, compare):
@@ -123,6 +125,14 @@ def _parser() -> argparse.ArgumentParser:
     _parallel_options(experiment)
     experiment.add_argument("--seed", type=int, default=0, help="seed of the random pushes (perturbation)")
     experiment.add_argument("--json", action="store_true", help="print the experiment's summary as one JSON object")
+
+    soak = sub.add_parser("soak", help="swim for hours with the log streaming to disk, sampling memory: "
+                                       "reports RSS growth and whether everything stayed finite")
+    soak.add_argument("--hours", type=float, default=1.0, help="simulated hours (default 1; ~10 min of wall time each)")
+    soak.add_argument("--stroke", default="front_crawl")
+    soak.add_argument("--out", help="output folder (default runs/soak-<timestamp>)")
+    _overwrite_option(soak)
+    soak.add_argument("--json", action="store_true")
 
     bench = sub.add_parser("bench", help="time one physics step, bare and through the whole loop")
     bench.add_argument("--json", action="store_true")
@@ -323,6 +333,18 @@ def _cmd_bench(args) -> None:
     print(_table([[k, _fmt(v)] for k, v in result.items()]))
 
 
+def _cmd_soak(args) -> None:
+    from layered_swim.runs import default_out_dir, soak
+
+    out = _out_dir(args, default_out_dir("soak"))
+    result = soak(args.hours, args.stroke, out, progress=not args.json and sys.stderr.isatty())
+    if args.json:
+        print(json.dumps({**result, "out_dir": str(out)}, allow_nan=False))
+        return
+    print(_table([[k, _fmt(v)] for k, v in _flat(result).items() if v is not None]))
+    print(f"\nwrote summary.json, config.json, log.npz, timeseries.csv to {out}")
+
+
 def _vector(text: str, what: str) -> tuple[float, float, float]:
     from layered_swim.config import ConfigError
 
@@ -433,12 +455,16 @@ def _summary_rows(result: dict) -> list[list[str]]:
 
 
 def _cmd_analyze(args) -> None:
-    from layered_swim.analysis.stroke_analysis import analyze_stroke, write_analysis
+    from layered_swim.analysis.stroke_analysis import analyze_run, analyze_stroke, write_analysis
     from layered_swim.runs import default_out_dir
 
-    config = _analysis_config(args, args.stroke)
-    out = _out_dir(args, default_out_dir(f"analyze-{Path(args.stroke).stem}"))
-    result = analyze_stroke(config, progress=not args.json and sys.stderr.isatty())
+    if args.run:
+        out = _out_dir(args, default_out_dir(f"analyze-{Path(args.run).name}"))
+        result = analyze_run(args.run, args.settle)
+    else:
+        config = _analysis_config(args, args.stroke)
+        out = _out_dir(args, default_out_dir(f"analyze-{Path(args.stroke).stem}"))
+        result = analyze_stroke(config, progress=not args.json and sys.stderr.isatty())
     files = write_analysis(result, out)
     if args.json:
         print(json.dumps({"stroke": result["stroke"], **result["summary"], "out_dir": str(out)}, allow_nan=False))
@@ -488,7 +514,8 @@ def _cmd_experiment(args) -> None:
 
 COMMANDS = {"run": _cmd_run, "strokes": _cmd_strokes, "validate": _cmd_validate, "bench": _cmd_bench,
             "calibrate": _cmd_calibrate, "follow": _cmd_follow, "goal": _cmd_goal, "analyze": _cmd_analyze,
-            "compare": _cmd_compare, "experiment": _cmd_experiment, "render": _cmd_render}
+            "compare": _cmd_compare, "experiment": _cmd_experiment, "render": _cmd_render,
+            "soak": _cmd_soak}
 
 
 def main(argv: list[str] | None = None) -> int:

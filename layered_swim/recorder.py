@@ -140,13 +140,15 @@ class Recorder:
         chunk = {name: np.array(rows, dtype=float) for name, rows in self._rows.items()}
         chunk["head_top_m"] = head_top_height_m(chunk["segment_pos_m"][:, self._head],
                                                 chunk["segment_quat_xyzw"][:, self._head], self._head_half_z_m)
-        for rows in self._rows.values():
-            rows.clear()
         if self._spool is None:
             self._chunks.append(chunk)
         else:
-            np.savez(self._spool / f"chunk-{self.n_chunks:06d}.npz", **chunk)
+            # Whole or not at all: a Ctrl-C in the middle leaves the rows here for the final save.
+            with atomic_path(self._spool / f"chunk-{self.n_chunks:06d}.npz") as tmp:
+                np.savez(tmp, **chunk)
         self.n_chunks += 1
+        for rows in self._rows.values():
+            rows.clear()
 
     def _chunk_iter(self) -> Iterator[dict[str, np.ndarray]]:
         self._flush()
@@ -157,7 +159,7 @@ class Recorder:
         chunks = list(self._chunk_iter())
         if not chunks:
             raise ConfigError("the run ended before its first log sample")
-        return {name: np.concatenate([c[name] for c in chunks]) for name in _logged_names(chunks[0])}
+        return {name: np.concatenate([c[name] for c in chunks]) for name in logged_names(chunks[0])}
 
     def log_hash(self) -> str:
         return log_hash(self.arrays())
@@ -170,7 +172,7 @@ class Recorder:
         first = next(chunks(), None)
         if first is None:
             raise ConfigError("the run ended before its first log sample")
-        names = _logged_names(first)
+        names = logged_names(first)
         rows = sum(len(c["time_s"]) for c in chunks())
         with atomic_path(out_dir / "log.npz") as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as archive:
             for name in names:
@@ -192,7 +194,8 @@ class Recorder:
             shutil.rmtree(self._spool, ignore_errors=True)
 
 
-def _logged_names(chunk: Mapping[str, np.ndarray]) -> list[str]:
+def logged_names(chunk: Mapping[str, np.ndarray]) -> list[str]:
+    """The per-sample arrays in ``chunk`` (a log less its name lists), in the hash's order."""
     return [name for name in ARRAY_NAMES + OPTIONAL_ARRAY_NAMES if name in chunk]
 
 
@@ -223,7 +226,7 @@ def read_log(run_dir: str | Path) -> dict[str, np.ndarray]:
             chunks = list(_spooled_chunks(spool))
             if not chunks:
                 raise ValueError("no chunks")
-            log = {name: np.concatenate([c[name] for c in chunks]) for name in _logged_names(chunks[0])}
+            log = {name: np.concatenate([c[name] for c in chunks]) for name in logged_names(chunks[0])}
             log.update({k: np.array(v) for k, v in json.loads((spool / "names.json").read_text()).items()})
             log["partial"] = True
         else:

@@ -7,7 +7,9 @@ file), ``goal_run`` is ``goal`` (SWIM's benchmark: one episode reset onto each g
 from __future__ import annotations
 
 import math
+import os
 import platform
+import resource
 import time
 from dataclasses import asdict
 from importlib import metadata
@@ -129,22 +131,23 @@ def run_swim(stroke: str, seconds: float = 30.0, lung_air_l: float | None = None
 
 
 def logged_swim(episode: Episode, seconds: float, out_dir: Path, log_hz: int = DEFAULT_LOG_HZ,
-                progress: bool = False, extra: dict | None = None) -> dict:
+                progress: bool = False, extra: dict | None = None, observers=(), report=None) -> dict:
     """``swim`` with its log streamed into ``out_dir`` (flat memory for any length); writes
     ``log.npz``, ``timeseries.csv`` and ``summary.json`` (``extra`` first, then the task's
-    metrics and the fluid's report) and returns the summary. A run stopped early (Ctrl-C, a
-    blow-up) saves what it logged, marked ``partial`` in its summary, then stops the caller too."""
+    metrics, the fluid's report and ``report()``) and returns the summary. A run stopped early
+    (Ctrl-C, a blow-up) saves what it logged, marked ``partial`` in its summary, then stops the
+    caller too."""
     try:
-        recorder = Recorder(episode.sim, log_hz, spool_dir=out_dir / SPOOL_DIR)
+        recorder = Recorder(episode.sim, log_hz, joint_work=True, spool_dir=out_dir / SPOOL_DIR)
     except BaseException:
         episode.close()
         raise
     stopped = None
     try:
-        swim(episode, seconds, [recorder], progress)
+        swim(episode, seconds, [recorder, *observers], progress)
     except (KeyboardInterrupt, SimulationDiverged, FluidError) as err:
         stopped = err
-    result = {**(extra or {}), **_metrics(episode, stopped), **fluid_report(episode)}
+    result = {**(extra or {}), **_metrics(episode, stopped), **fluid_report(episode), **(report() if report else {})}
     if stopped is not None:
         reason = "interrupted" if isinstance(stopped, KeyboardInterrupt) else " ".join(str(stopped).split())
         result["partial"] = {"stopped_at_s": episode.time_s, "of_s": seconds, "reason": reason}
@@ -154,6 +157,50 @@ def logged_swim(episode: Episode, seconds: float, out_dir: Path, log_hz: int = D
     write_json(out_dir / "summary.json", result)
     if stopped is not None:
         raise stopped
+    return result
+
+
+SOAK_SAMPLE_S = 10.0        # simulated seconds between memory samples
+SOAK_WARMUP_SHARE = 0.1     # growth is counted from this far in: imports, compiles and first buffers come before
+
+
+def rss_mb() -> float:
+    """This process's resident memory now (Linux's /proc), else its peak so far."""
+    try:
+        pages = int(Path("/proc/self/statm").read_text().split()[1])
+        return pages * os.sysconf("SC_PAGE_SIZE") / 2**20
+    except (OSError, ValueError, IndexError):
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def soak(hours: float, stroke: str, out_dir: Path, progress: bool = False) -> dict:
+    """Swim ``hours`` of simulated time with the log streaming into ``out_dir``, sampling memory
+    every ``SOAK_SAMPLE_S``; the summary adds RSS at the start of the counted stretch, at the end
+    and at peak, the growth over the stretch, and whether everything stayed finite."""
+    if not (math.isfinite(hours) and 0.0 < hours <= 24.0):
+        raise ConfigError(f"--hours must be in (0, 24], got {hours}")
+    seconds = hours * 3600.0
+    episode = Episode(stroke, FreeSwim(sample_hz=DEFAULT_LOG_HZ))
+    write_json(out_dir / "config.json", resolved_config(episode, {"hours": hours, "stroke": stroke,
+                                                                  "out_dir": str(out_dir)}, DEFAULT_LOG_HZ, "soak"))
+    every = int(round(SOAK_SAMPLE_S * episode.sim.config.physics_hz))
+    samples = [(0.0, rss_mb())]
+    sample = (lambda sim: samples.append((sim.time_s, rss_mb())) if sim.steps % every == 0 else None)
+
+    def memory() -> dict:
+        times, rss = np.array(samples).T
+        counted = rss[times >= SOAK_WARMUP_SHARE * times[-1]]
+        growth = float(counted[-1] - counted[0])
+        span_h = max(times[-1] * (1.0 - SOAK_WARMUP_SHARE), 1e-9) / 3600.0
+        return {"memory": {"samples": len(samples), "rss_start_mb": round(float(counted[0]), 1),
+                           "rss_end_mb": round(float(rss[-1]), 1), "rss_peak_mb": round(float(rss.max()), 1),
+                           "growth_mb": round(growth, 1), "growth_mb_per_hour": round(growth / span_h, 1),
+                           "process_peak_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)}}
+
+    result = logged_swim(episode, seconds, out_dir, progress=progress, observers=[sample], report=memory)
+    numbers = [v for v in result.values() if isinstance(v, float)]
+    result["finite"] = bool(np.isfinite(numbers).all())
+    write_json(out_dir / "summary.json", result)
     return result
 
 

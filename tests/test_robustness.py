@@ -117,12 +117,17 @@ def test_ctrl_c_keeps_a_readable_partial_log(tmp_path):
     _wait_for_chunk(out, process)
     process.send_signal(signal.SIGINT)
     _, err = process.communicate(timeout=60)
-    assert process.returncode == 130 and "interrupted" in err
+    assert process.returncode == 130 and "interrupted" in err, err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["partial"]["reason"] == "interrupted" and 0 < summary["partial"]["stopped_at_s"] < 3600
     log = read_log(out)
     assert not log["partial"] and len(log["time_s"]) >= CHUNK_ROWS and not (out / "log.partial").exists()
     assert np.isfinite(log["desired_pose_rad"]).all() and np.isfinite(log["fluid_force_n"]).all()
+    analysed = cli("analyze", "--run", str(out), "--json", "--out", str(tmp_path / "analysis"))
+    assert analysed.returncode == 0, analysed.stderr
+    assert json.loads(analysed.stdout)["cycles"] >= 2
+    config = json.loads((tmp_path / "analysis" / "config.json").read_text())
+    assert config["command"] == "analyze" and config["arguments"]["partial_log"] is True
 
 
 def test_a_killed_run_leaves_chunks_that_read_back(tmp_path):
@@ -133,3 +138,14 @@ def test_a_killed_run_leaves_chunks_that_read_back(tmp_path):
     process.communicate(timeout=60)
     log = read_log(out)
     assert log["partial"] and len(log["time_s"]) % CHUNK_ROWS == 0 and log["time_s"][0] > 0
+
+
+def test_soak_reports_memory_and_finiteness(tmp_path):
+    result = cli("soak", "--hours", "0.006", "--stroke", "breaststroke", "--json", "--out", str(tmp_path / "soak"))
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    memory = summary["memory"]
+    assert summary["finite"] is True and memory["samples"] == 3      # at 0, 10 and 20 s of 21.6
+    assert 0 < memory["rss_start_mb"] <= memory["rss_peak_mb"] and abs(memory["growth_mb"]) < 100
+    assert read_log(tmp_path / "soak")["time_s"][-1] == pytest.approx(21.6)
+    assert_one_line_error(cli("soak", "--hours", "-1", "--out", str(tmp_path / "bad")), "--hours")

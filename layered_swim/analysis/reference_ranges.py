@@ -1,7 +1,7 @@
-"""Real swimmers' ranges from the data sheet (reference/data-sheet.md, section 3), per stroke,
+"""Real swimmers' ranges from ``layered_swim/reference.md`` (section 3), per stroke,
 and the verdict of a measured number against them (inside / below / above).
 
-Only the data sheet's numbers are used; a quantity it gives no range for gets none here, and
+Only its numbers are used; a quantity it gives no range for gets none here, and
 the report says so rather than inventing one.
 """
 from __future__ import annotations

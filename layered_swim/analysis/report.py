@@ -82,7 +82,7 @@ def analysis_report(result: dict, table: list[dict], plot_files: list[str]) -> s
              f"{setting_line(result['config'])}: {s['cycles']} whole cycles over {s['analysed_s']:.1f} s "
              f"(the controller's nominal rate is {s['nominal_stroke_rate_cpm']:.1f} cycles/min).", "",
              "## Numbers next to real swimmers", "",
-             "Ranges from `reference/data-sheet.md` section 3 (R: recalled from the literature, E: estimated);",
+             "Ranges from `layered_swim/reference.md` section 3 (R: recalled from the literature, E: estimated);",
              "elite ranges are for racing swimmers, so a recreational-speed swimmer is expected below them.", "",
              "| quantity | ours (mean +- SD over cycles) | real swimmers | verdict | source |",
              "|---|---|---|---|---|"]
@@ -114,7 +114,7 @@ def compare_report(results: list[dict], tables: list[list[dict]], figure_file: s
     by_stroke = [{row["quantity"]: row for row in table} for table in tables]
     lines = ["# Strokes side by side", "",
              "Each cell: ours (mean +- SD over cycles) and, in brackets, the verdict against the real "
-             "swimmers' range for that stroke (data sheet section 3; '-' where it gives none).", "",
+             "swimmers' range for that stroke (layered_swim/reference.md section 3; '-' where it gives none).", "",
              "| quantity | " + " | ".join(strokes) + " |", "|---|" + "---|" * len(strokes)]
     for name in QUANTITIES:
         cells = []

@@ -17,12 +17,13 @@ from layered_swim.tasks.metrics import SETTLE_S
 from layered_swim.analysis.reference_ranges import ranges_for
 from layered_swim.analysis.stroke_metrics import SwimmerInfo, analyze_log
 from layered_swim.analysis.sweep import file_sha256, run_sweep
-from layered_swim.config import ConfigError
+from layered_swim.config import ConfigError, load_json
 from layered_swim.control.stroke import stroke_path
 from layered_swim.episode import Episode
 from layered_swim.fluid import make_fluid
 from layered_swim.fluid.sph import SphSettings
 from layered_swim.outputs import COMMAND_KEY, write_json, write_text
+from layered_swim.recorder import logged_names, read_log
 from layered_swim.runs import check_seconds, make_medium, record, resolved_config
 
 ANALYSIS_LOG_HZ = 120      # ~100 samples per stroke cycle for the profiles
@@ -65,6 +66,37 @@ def analyze_stroke(config: dict, progress: bool = False) -> dict:
             "config": resolved_config(episode, config, ANALYSIS_LOG_HZ, "analyze")}
 
 
+def analyze_run(run_dir: str | Path, settle_s: float = SETTLE_S) -> dict:
+    """The same analysis of a finished (or stopped, partial) ``run`` folder's log, no new swim."""
+    run_dir = Path(run_dir)
+    log = read_log(run_dir)
+    config_path = run_dir / "config.json"
+    config = load_json(config_path)
+    try:
+        spec, tempo = config["stroke"], float(config["arguments"]["tempo"])
+        name, posture, period_s = str(spec["name"]), str(spec["start"]["posture"]), float(spec["period_s"]) / tempo
+    except (KeyError, TypeError, ValueError, ZeroDivisionError):
+        raise ConfigError(f"{config_path}: not the config of a `layered-swim run` folder (no stroke, posture, "
+                          "period or tempo)") from None
+    if "joint_work_j" not in log:
+        raise ConfigError(f"{run_dir}: its log has no joint work (joint_work_j), which the power figures need")
+    if not (math.isfinite(settle_s) and 0.0 <= settle_s < log["time_s"][-1]):
+        raise ConfigError(f"settle time must be at least 0 and shorter than the run ({log['time_s'][-1]:g} s), "
+                          f"got {settle_s}")
+    arrays = {name: log[name] for name in logged_names(log)}
+    result = analyze_log(arrays, SwimmerInfo(tuple(str(n) for n in log["segment_names"]), posture, period_s, settle_s))
+    result["summary"]["nominal_stroke_rate_cpm"] = 60.0 / period_s
+    arguments = {**config["arguments"], "seconds": float(log["time_s"][-1]), "settle_s": settle_s,
+                 "run_dir": str(run_dir), "partial_log": bool(log["partial"]) or _stopped_early(run_dir)}
+    return {"stroke": name, "posture": posture, **result,
+            "config": {**config, COMMAND_KEY: "analyze", "arguments": arguments}}
+
+
+def _stopped_early(run_dir: Path) -> bool:
+    summary = run_dir / "summary.json"
+    return summary.exists() and "partial" in (load_json(summary) or {})
+
+
 def comparisons(result: dict) -> list[dict]:
     """Every summary number next to the real swimmers' range for this stroke, where there is one."""
     summary = result["summary"]
@@ -79,7 +111,7 @@ def comparisons(result: dict) -> list[dict]:
         rng = ranges.get(name)
         rows.append({"quantity": name, "mean": mean, "sd": sd,
                      "low": rng.low if rng else None, "high": rng.high if rng else None,
-                     "verdict": rng.verdict(mean) if rng else "no range in the data sheet",
+                     "verdict": rng.verdict(mean) if rng else "no range in reference.md",
                      "source": rng.source if rng else ""})
     return rows
 

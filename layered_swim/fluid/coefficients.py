@@ -8,8 +8,8 @@ Yang et al.'s alpha = acos(D . N).
 import numpy as np
 
 # Source: Atkinson, ROWING model, "Hydrofoil: Flat plate, fully immersed, b/c=0.2,
-# after Hoerner" (http://www.atkinsopht.com/row/liftdrag.htm), copied from
-# shared/reference/hoerner_flat_plate_ar0.2.txt. 42.5 deg appears twice: before
+# after Hoerner" (http://www.atkinsopht.com/row/liftdrag.htm), see
+# layered_swim/reference.md, section 1. 42.5 deg appears twice: before
 # and after stall.
 HOERNER_AR02_A_DEG = np.array(
     [0, 1, 2, 3, 5, 7, 10, 15, 20, 25, 30, 33, 35, 37, 39, 41, 42.5, 42.5,

@@ -94,7 +94,7 @@ def _frames(source, seconds, fps, stroke, layers, current_m_s, density_kg_m3, ba
             yield session.scene()
             session.step(frame_steps(k, session.physics_hz, fps))
             if session.diverged:
-                raise SimulationDiverged(session.message)
+                raise SimulationDiverged(session.divergence)
     finally:
         session.close()
 

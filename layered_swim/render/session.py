@@ -124,6 +124,7 @@ class SwimSession:
         self._next_trail_s = 0.0
         self._accumulator_s = 0.0
         self.diverged = False
+        self.divergence = ""            # what blew up, for a caller with no R key (headless render)
         self.speed_m_s = float(np.hypot(*self.sim.state.com_vel_m_s[:2]))
         self._rate_samples: deque = deque()
         self.realtime_factor = 0.0
@@ -210,7 +211,7 @@ class SwimSession:
         try:
             self.episode.run(steps=steps, observers=[self._after_step])
         except SimulationDiverged as err:
-            self.diverged = True
+            self.diverged, self.divergence = True, str(err)
             self.message = f"{err}; press R to reset"
 
     def _after_step(self, sim) -> None:

@@ -23,8 +23,7 @@ class FreeSwim(Task):
         self._stroke, self._controller = episode.stroke.name, episode.sim.controller
         body = episode.body
         self._head_half_z_m = float(body.half_extents_m[body.index("head"), 2])
-        self._samples = SampleLog({"time_s": 1, "com_m": 3, "pelvis_m": 3, "thorax_quat": 4, "head_pos_m": 3,
-                                   "head_quat": 4})
+        self._samples = SampleLog({"time_s": 1, "com_m": 3, "pelvis_m": 3, "thorax_quat": 4, "head_top_m": 1})
         return moved_start(episode.stroke.start_state(), speed_m_s=self.speed_m_s)
 
     def observe(self, sim) -> None:
@@ -33,10 +32,9 @@ class FreeSwim(Task):
         s = sim.state
         self._samples.append(time_s=sim.steps / sim.config.physics_hz,   # exact, unlike a running sum of dt
                              com_m=s.com_m, pelvis_m=s.pos("pelvis"), thorax_quat=s.quat("thorax"),
-                             head_pos_m=s.pos("head"), head_quat=s.quat("head"))
+                             head_top_m=head_top_height_m(s.pos("head"), s.quat("head"), self._head_half_z_m))
 
     def metrics(self) -> dict:
         a = self._samples.arrays()
-        head_top = head_top_height_m(a["head_pos_m"], a["head_quat"], self._head_half_z_m)
-        return summary(a["time_s"], a["com_m"], a["pelvis_m"], a["thorax_quat"], head_top,
+        return summary(a["time_s"], a["com_m"], a["pelvis_m"], a["thorax_quat"], a["head_top_m"],
                        self._controller.cycles_per_s, self._stroke)

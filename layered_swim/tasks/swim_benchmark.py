@@ -20,7 +20,7 @@ START_DEPTH_M = 0.05
 
 # SWIM's theta_tol is "style-specific, informed by the roll angles of elite swimmers" (eq. 14)
 # but never given. Front crawl: the low end of elite shoulder roll, 45-60 deg per side
-# (Psycharakis & Sanders 2010, data sheet section 3); breaststroke barely rolls.
+# (Psycharakis & Sanders 2010, layered_swim/reference.md section 3); breaststroke barely rolls.
 ROLL_TOLERANCE_DEG = {"front_crawl": 45.0, "breaststroke": 15.0}
 
 
