@@ -15,9 +15,9 @@ PROG = "app.py"
 
 
 def parser() -> argparse.ArgumentParser:
-    from layered_swim.cli import steering_options   # argparse only: --help stays fast
+    from layered_swim.cli import OneLineParser, steering_options   # argparse only: --help stays fast
 
-    p = argparse.ArgumentParser(prog=PROG, description="Swim after the mouse (or a trajectory) in a real-time 3-D window.")
+    p = OneLineParser(prog=PROG, description="Swim after the mouse (or a trajectory) in a real-time 3-D window.")
     p.add_argument("--stroke", default="breaststroke", help="stroke name or path to a stroke .yaml (default breaststroke)")
     p.add_argument("--trajectory", help="a trajectory name or .yaml file: show its path and chase its target")
     p.add_argument("--backend", default="plate",

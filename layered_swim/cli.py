@@ -17,7 +17,7 @@ from pathlib import Path
 PROG = "layered-swim"
 
 
-class _Parser(argparse.ArgumentParser):
+class OneLineParser(argparse.ArgumentParser):
     """argparse with one-line errors, and values like ``-5,0,5`` taken as values, not options."""
 
     def __init__(self, *args, **kwargs):
@@ -41,7 +41,7 @@ def _guard_stdout() -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = _Parser(prog=PROG, description="A physically simulated human swimmer.")
+    p = OneLineParser(prog=PROG, description="A physically simulated human swimmer.")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     run = sub.add_parser("run", help="swim a stroke headless and write summary, log and config")
