@@ -10,6 +10,8 @@ import math
 import os
 import platform
 import resource
+import subprocess
+import sys
 import time
 from dataclasses import asdict
 from importlib import metadata
@@ -123,6 +125,8 @@ def run_swim(stroke: str, seconds: float = 30.0, lung_air_l: float | None = None
                  "fluid": fluid, "log_hz": log_hz, "backend": backend}
     check_seconds(seconds)
     out_dir.mkdir(parents=True, exist_ok=True)
+    if seconds > WARM_UP_AFTER_S:
+        warm_compiled_kernels(stroke)
     episode = Episode(stroke, FreeSwim(sample_hz=log_hz), medium=make_medium(fluid, density), backend=backend,
                       fluid_settings=fluid_settings, lung_air_l=lung_air_l, physics_hz=physics_hz, tempo=tempo,
                       seed=seed)
@@ -160,6 +164,23 @@ def logged_swim(episode: Episode, seconds: float, out_dir: Path, log_hz: int = D
     return result
 
 
+WARM_UP_AFTER_S = 600.0     # runs longer than this have the numba kernels compiled in a child first
+
+
+def warm_compiled_kernels(stroke: str) -> None:
+    """Swim a moment in a child process, where numba compiles the kernels and caches them on disk;
+    this process then loads them compiled. A process that compiles keeps LLVM's working memory
+    (~100 MB) for the rest of its life, which for a long run is most of its footprint beyond the
+    imports. Best effort: if the child fails, this process compiles as before."""
+    code = ("from layered_swim.runs import Episode, FreeSwim, Recorder\n"
+            f"episode = Episode({stroke!r}, FreeSwim())\n"
+            "recorder = Recorder(episode.sim, joint_work=True)\n"
+            "episode.run(0.2, observers=[recorder])\n"
+            "recorder.arrays(); episode.metrics()\n")
+    subprocess.run([sys.executable, "-c", code], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=False,
+                   timeout=900)
+
+
 SOAK_SAMPLE_S = 10.0        # simulated seconds between memory samples
 SOAK_WARMUP_SHARE = 0.1     # growth is counted from this far in: imports, compiles and first buffers come before
 
@@ -180,6 +201,7 @@ def soak(hours: float, stroke: str, out_dir: Path, progress: bool = False) -> di
     if not (math.isfinite(hours) and 0.0 < hours <= 24.0):
         raise ConfigError(f"--hours must be in (0, 24], got {hours}")
     seconds = hours * 3600.0
+    warm_compiled_kernels(stroke)
     episode = Episode(stroke, FreeSwim(sample_hz=DEFAULT_LOG_HZ))
     write_json(out_dir / "config.json", resolved_config(episode, {"hours": hours, "stroke": stroke,
                                                                   "out_dir": str(out_dir)}, DEFAULT_LOG_HZ, "soak"))

@@ -174,12 +174,16 @@ def _mutated_log(draw, log: dict) -> dict:
     return log
 
 
+def _copy(run_folder, target):
+    shutil.rmtree(target, ignore_errors=True)
+    shutil.copytree(run_folder, target)
+    return target
+
+
 @given(data=st.data())
 @FUZZ
 def test_run_folder_logs(data, run_folder, folder):
-    target = folder / "replayed"
-    shutil.rmtree(target, ignore_errors=True)
-    shutil.copytree(run_folder, target)
+    target = _copy(run_folder, folder / "replayed")
     how = data.draw(st.sampled_from(["arrays", "arrays", "bytes", "truncate", "random"]))
     raw = (run_folder / "log.npz").read_bytes()
     if how == "arrays":
@@ -202,9 +206,7 @@ def test_run_folder_logs(data, run_folder, folder):
 @given(data=st.data())
 @FUZZ
 def test_run_folder_configs(data, run_folder, folder):
-    target = folder / "configured"
-    shutil.rmtree(target, ignore_errors=True)
-    shutil.copytree(run_folder, target)
+    target = _copy(run_folder, folder / "configured")
     original = (run_folder / "config.json").read_text()
     if data.draw(st.booleans()):
         text = json.dumps(data.draw(mutated(json.loads(original))))
