@@ -11,6 +11,7 @@ from dataclasses import asdict
 import math
 import os
 import re
+import signal
 import sys
 from pathlib import Path
 
@@ -522,6 +523,9 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point. Redirects fd 1 for the rest of the process (see ``_guard_stdout``): call it
     in a subprocess, not inside a test runner that captures output."""
     _guard_stdout()
+    # A shell script's background job starts with SIGINT ignored; `kill -INT` must still stop a
+    # run (keeping its log), so take Ctrl-C's handler back.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     args = _parser().parse_args(argv)
     return report_errors(PROG, lambda: COMMANDS[args.command](args))
 
