@@ -19,7 +19,10 @@ which layers are on; the per-cycle layer reads the stroke's calibration table).
 """
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
+import threading
 from dataclasses import replace
 from typing import Callable, Iterable
 
@@ -109,11 +112,14 @@ class Episode:
             observers.append(lambda sim: bar.update(1) if sim.steps % hz == 0 else None)
         try:
             sim, task = self.sim, self.task
-            for _ in range(n):
-                sim.step()
-                task.observe(sim)
-                for every_step in observers:
-                    every_step(sim)
+            with _ctrl_c_between_steps() as stop:
+                for _ in range(n):
+                    sim.step()
+                    task.observe(sim)
+                    for every_step in observers:
+                        every_step(sim)
+                    if stop:
+                        raise KeyboardInterrupt
         finally:
             if progress:
                 bar.close()
@@ -123,6 +129,31 @@ class Episode:
 
     def close(self) -> None:
         self.sim.close()
+
+
+@contextlib.contextmanager
+def _ctrl_c_between_steps():
+    """While the loop runs, Ctrl-C (SIGINT) only asks it to stop after the current step: a
+    KeyboardInterrupt raised inside a compiled (numba) kernel surfaces as a SystemError
+    traceback, not as an interrupt. A second Ctrl-C interrupts at once. Yields a list that is
+    non-empty once a stop is asked for. Only where Python's own handler is installed (the main
+    thread, SIGINT not ignored)."""
+    asked: list[bool] = []
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        yield asked
+        return
+
+    def ask(signum, frame):
+        if asked:
+            raise KeyboardInterrupt
+        asked.append(True)
+
+    signal.signal(signal.SIGINT, ask)
+    try:
+        yield asked
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 START_JITTER = {"heading_rad": math.radians(5.0), "position_m": 0.1, "depth_m": 0.03, "speed_share": 0.1}
