@@ -162,7 +162,7 @@ def _water_options(command: argparse.ArgumentParser) -> None:
     fluid.add_argument("--fluid", choices=("fresh_water", "seawater"), default="fresh_water")
     command.add_argument("--seed", type=int, default=0,
                          help="0 (default): the stroke's exact start; any other: a start jittered by it "
-                              "(heading, speed, depth, pose; see README)")
+                              "(heading, speed, depth, position; see README)")
     command.add_argument("--physics-hz", type=int, default=480)
 
 

@@ -228,11 +228,11 @@ def soak(hours: float, stroke: str, out_dir: Path, progress: bool = False) -> di
 
 def _metrics(episode: Episode, stopped: BaseException | None) -> dict:
     """The task's metrics; a run stopped too early to have them gets none rather than a second error."""
-    if stopped is None:
-        return episode.metrics()
     try:
         return episode.metrics()
     except (ValueError, IndexError, ZeroDivisionError, ConfigError):
+        if stopped is None:
+            raise
         return {}
 
 
@@ -251,14 +251,13 @@ def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = L
         return {**head, **episode.metrics(), **fluid_report(episode)}
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    write_json(out / "config.json", {"command": "follow", "trajectory": str(target.source),
-                                     "trajectory_spec": _dump(target.spec),
-                                         "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
-                                         "density_kg_m3": density, "seconds": seconds,
-                                         "stroke_file": episode.stroke.source,
-                                         "fluid_backend": {"name": episode.sim.fluid.name,
-                                                           "settings": episode.sim.fluid.settings()},
-                                         "cycles_per_s_at_tempo_1": 1.0 / episode.stroke.period_s})
+    write_json(out / "config.json", {COMMAND_KEY: "follow", "trajectory": str(target.source),
+                                     "trajectory_spec": _dump(target.spec), "stroke": stroke,
+                                     "layers": layers.describe(), "current_m_s": list(current),
+                                     "density_kg_m3": density, "seconds": seconds, "stroke_file": episode.stroke.source,
+                                     "fluid_backend": {"name": episode.sim.fluid.name,
+                                                       "settings": episode.sim.fluid.settings()},
+                                     "cycles_per_s_at_tempo_1": 1.0 / episode.stroke.period_s})
     try:
         return logged_swim(episode, seconds, out, extra=head)
     finally:
