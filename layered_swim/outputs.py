@@ -16,7 +16,7 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
-from layered_swim.config import ConfigError
+from layered_swim.config import ConfigError, load_json
 
 COMMAND_KEY = "command"     # config.json's field naming the command that wrote the folder
 
@@ -47,8 +47,8 @@ def prepare_out_dir(path: str | Path, command: str, overwrite: bool = False) -> 
 
 def _command_of(folder: Path) -> str | None:
     try:
-        config = json.loads((folder / "config.json").read_text())
-    except (OSError, ValueError):
+        config = load_json(folder / "config.json")
+    except ConfigError:        # none, or not ours: the caller says so
         return None
     command = config.get(COMMAND_KEY) if isinstance(config, dict) else None
     return command if isinstance(command, str) else None

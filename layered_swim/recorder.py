@@ -150,9 +150,10 @@ class Recorder:
         for rows in self._rows.values():
             rows.clear()
 
-    def _chunk_iter(self) -> Iterator[dict[str, np.ndarray]]:
+    def _chunk_iter(self, names: tuple[str, ...] | None = None) -> Iterator[dict[str, np.ndarray]]:
+        """Every chunk so far; from disk, only ``names`` (all when None) are read."""
         self._flush()
-        return iter(self._chunks) if self._spool is None else _spooled_chunks(self._spool)
+        return iter(self._chunks) if self._spool is None else _spooled_chunks(self._spool, names)
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The whole log in memory (short runs and analyses)."""
@@ -172,21 +173,20 @@ class Recorder:
         first = next(chunks(), None)
         if first is None:
             raise ConfigError("the run ended before its first log sample")
-        names = logged_names(first)
-        rows = sum(len(c["time_s"]) for c in chunks())
+        rows = sum(len(c["time_s"]) for c in chunks(("time_s",)))
         with atomic_path(out_dir / "log.npz") as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as archive:
-            for name in names:
+            for name in logged_names(first):      # one array at a time: each pass reads only it
                 with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
                     shape = (rows, *first[name].shape[1:])
                     np.lib.format.write_array_header_2_0(member, {"descr": "<f8", "fortran_order": False, "shape": shape})
-                    for chunk in chunks():
+                    for chunk in chunks((name,)):
                         member.write(np.ascontiguousarray(chunk[name], dtype="<f8").tobytes())
             for name, values in self.names.items():
                 with archive.open(f"{name}.npy", "w") as member:
                     np.lib.format.write_array(member, np.array(values))
         with atomic_path(out_dir / "timeseries.csv") as tmp, tmp.open("w") as f:
             f.write(",".join(CSV_COLUMNS) + "\n")
-            for c in chunks():
+            for c in chunks(("time_s", "root_pos_m", "com_vel_m_s", "head_top_m")):
                 table = np.column_stack([c["time_s"], c["root_pos_m"], np.linalg.norm(c["com_vel_m_s"], axis=1),
                                          c["head_top_m"]])
                 np.savetxt(f, table, fmt="%.6f", delimiter=",")
@@ -199,10 +199,10 @@ def logged_names(chunk: Mapping[str, np.ndarray]) -> list[str]:
     return [name for name in ARRAY_NAMES + OPTIONAL_ARRAY_NAMES if name in chunk]
 
 
-def _spooled_chunks(folder: Path) -> Iterator[dict[str, np.ndarray]]:
+def _spooled_chunks(folder: Path, names: tuple[str, ...] | None = None) -> Iterator[dict[str, np.ndarray]]:
     for path in sorted(folder.glob("chunk-*.npz")):
         with np.load(path, allow_pickle=False) as chunk:
-            yield {name: chunk[name] for name in chunk.files}
+            yield {name: chunk[name] for name in (chunk.files if names is None else names)}
 
 
 # What a damaged .npz can raise while being read (a bad zip, a bad deflate stream, a bad header).
