@@ -126,6 +126,7 @@ def _parser() -> argparse.ArgumentParser:
     _parallel_options(experiment)
     experiment.add_argument("--seed", type=int, default=0, help="seed of the random pushes (perturbation)")
     experiment.add_argument("--json", action="store_true", help="print the experiment's summary as one JSON object")
+    _backend_option(experiment, pool="large")     # only hand-force runs in SPH water (`experiment list`)
 
     soak = sub.add_parser("soak", help="swim for hours with the log streaming to disk, sampling memory: "
                                        "reports RSS growth and whether everything stayed finite")
@@ -319,6 +320,11 @@ def _validate_sph(args) -> None:
         print(_table([[f"{r['speed_m_s']:g}", f"{r['drag_n']:.1f} +- {r['window_sd_n']:.1f}", f"{r['reference_n']:.1f}",
                        f"{r['ratio']:.3f}"] for r in part["towed_swimmer"]],
                      ["swimmer m/s", "SPH drag N", "Narita 23.5 v^2 N", "ratio"]))
+    print("\ndiagnostic: the broadside plate (shrunk) towed without gravity, so no hydrostatic pressure to lose "
+          "behind it (README, 'SPH backend')")
+    print(_table([[f"{r['speed_m_s']:g}", f"{r['drag_n']:.1f} +- {r['window_sd_n']:.1f}", f"{r['plate_model_n']:.1f}",
+                   _fmt(r["ratio"])] for r in result["broadside_without_gravity"]],
+                 ["speed m/s", "SPH drag N, g = 0", "plate model N", "ratio"]))
 
 
 def _cmd_bench(args) -> None:
@@ -500,12 +506,20 @@ def _cmd_experiment(args) -> None:
     from layered_swim.analysis.experiments.runner import run_experiment
 
     if args.name == "list":
-        print(_table([[name, module.TITLE] for name, module in EXPERIMENTS.items()], ["experiment", "reproduces"]))
+        print(_table([[name, module.TITLE, ",".join(getattr(module, "BACKENDS", ("plate",)))]
+                      for name, module in EXPERIMENTS.items()], ["experiment", "reproduces", "backends"]))
         return
     module = experiment(args.name)
     out = _out_dir(args, Path("runs") / f"experiment-{args.name}")
-    summary = run_experiment(module, out, quick=args.quick, workers=args.workers,
-                             progress=_progress(args), seed=args.seed)
+    settings = _fluid_settings(args)
+    if args.backend != "plate":       # a missing extra or bad setting: one line before any run starts
+        from layered_swim.body.model import load_body
+        from layered_swim.fluid import make_fluid
+        from layered_swim.fluid.medium import Medium
+
+        make_fluid(args.backend, load_body(), Medium(), 9.81, settings)
+    summary = run_experiment(module, out, quick=args.quick, workers=args.workers, progress=_progress(args),
+                             seed=args.seed, backend=args.backend, fluid_settings=settings)
     if args.json:
         print(json.dumps({**summary, "out_dir": str(out)}, allow_nan=False))
         return

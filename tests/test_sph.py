@@ -129,7 +129,19 @@ def test_cli_run_on_sph_writes_the_water_report(tmp_path):
     assert config["fluid_backend"]["settings"]["particle_radius_m"] == 0.05
 
 
+def test_the_hand_force_experiment_runs_in_sph_water(tmp_path):
+    done = _cli("experiment", "hand-force", "--backend", "sph", "--pool", "small", "--particle-radius", "0.05",
+                "--deterministic", "--no-progress", "--json", "--out", str(tmp_path))
+    assert done.returncode == 0, done.stderr
+    summary = json.loads(done.stdout)
+    assert summary["backend"] == "sph" and np.isfinite(summary["peak_force_n"]) and summary["mean_buoyancy_n"] is None
+    (run,) = json.loads((tmp_path / "config.json").read_text())["runs"]
+    assert run["backend"] == "sph" and run["fluid"]["particle_radius_m"] == 0.05
+    assert "SPH water (3 x 1.5 x 0.5 m pool" in (tmp_path / "report.md").read_text()
+
+
 @pytest.mark.parametrize("args, message", [
+    (["experiment", "turn"], "runs on the plate backend only"),
     (["run", "--stroke", "breaststroke", "--particle-radius", "0"], "particle_radius_m"),
     (["follow", "figure_eight", "--seconds", "60"], "leaves the 5 x 2 m SPH pool"),
     (["validate", "drag"], "validate sph"),

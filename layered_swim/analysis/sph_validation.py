@@ -5,6 +5,11 @@
   (the project's own plate kernel on the same box at the same velocity).
 - The draft of a free-floating box (density 500 kg/m^3: half its height under water).
 - The towed swimmer's passive drag against Narita et al. 2017's 23.5 v^2 N.
+- A diagnostic, not a correction: the broadside tows again without gravity. The SPH pressure
+  cannot go below zero, so the water parts from a face moving away from it (as if the pool were
+  in vacuum, where real water has the atmosphere pushing it back): the plate's back face loses
+  part of the hydrostatic pressure, a drag that grows with depth, not speed. Without gravity
+  there is no hydrostatic pressure to lose, and what is left is the water's dynamic drag.
 
 Each case runs without and with the boundary correction (boxes shrunk by ``mesh_shrink_radii``
 particle radii per side: SPH leaves a fluid-free skin about one radius thick on every wall, so
@@ -112,19 +117,20 @@ def tow(tank: Tank, start_m: np.ndarray, quat_xyzw: np.ndarray, speed_m_s: float
     return np.array(drag[steps // 2:])
 
 
-def towed_plate(settings: SphSettings, medium: Medium, speed_m_s: float, angle_deg: float, shrink: bool) -> dict:
+def towed_plate(settings: SphSettings, medium: Medium, speed_m_s: float, angle_deg: float, shrink: bool,
+                gravity_m_s2: float = 9.81) -> dict:
     """The plate, its face at ``angle_deg`` to the tow (90: broadside), towed along +x at mid-depth."""
     half_angle = math.radians(angle_deg) / 2
     quat = np.array([0.0, math.sin(half_angle), 0.0, math.cos(half_angle)])   # about y: local z (the normal) tilts to x
     depth = 0.3
     start = np.array([-0.6, 0.0, -depth])
-    tank = Tank(settings, medium, (2.2, 1.0, 0.6), PLATE_HALF_M, start, quat, shrink)
+    tank = Tank(settings, medium, (2.2, 1.0, 0.6), PLATE_HALF_M, start, quat, shrink, gravity_m_s2)
     try:
         mean, sd = windowed(tow(tank, start, quat, speed_m_s), tank.dt)
     finally:
         tank.close()
     model = plate_model_drag(medium, speed_m_s, quat)
-    return {"speed_m_s": speed_m_s, "angle_deg": angle_deg, "drag_n": mean, "window_sd_n": sd, "plate_model_n": model,
+    return {"speed_m_s": speed_m_s, "angle_deg": angle_deg, "gravity_m_s2": gravity_m_s2, "drag_n": mean, "window_sd_n": sd, "plate_model_n": model,
             "ratio": mean / model if model > 1e-6 else None}
 
 
@@ -181,4 +187,7 @@ def validate_sph(settings: SphSettings = SphSettings(), medium: Medium = Medium(
                                      for a in TOW_ANGLES_DEG for v in TOW_SPEEDS_M_S]
         say(f"{label}: towed swimmer")
         out[label]["towed_swimmer"] = [towed_swimmer(settings, medium, v, shrink) for v in SWIMMER_SPEEDS_M_S]
+    say("diagnostic: broadside plate towed without gravity")
+    out["broadside_without_gravity"] = [towed_plate(settings, medium, v, 90.0, True, gravity_m_s2=0.0)
+                                        for v in TOW_SPEEDS_M_S]
     return out

@@ -4,11 +4,15 @@ CSV and report. An experiment module provides
 - ``NAME``, ``TITLE``, ``PAPER`` (the paper's finding, in words), ``FIGURE`` and ``CSV`` file names;
 - ``configs(quick, seed)``: the runs, as JSON-able dicts (they are also the cache keys);
 - ``run(config)``: one simulation, returning a JSON-able result (module level, so it pickles);
-- ``finish(configs, results, out_dir)``: draws the figure, writes the CSV, returns an ``Outcome``.
+- ``finish(configs, results, out_dir)``: draws the figure, writes the CSV, returns an ``Outcome``;
+- optionally ``BACKENDS``, the fluid backends it makes sense on (the plates only by default: a
+  sweep of minute-long swims would take days in SPH water, and the pool has no current). With
+  another backend every config carries ``backend`` and ``fluid`` (the backend's settings), which
+  ``run`` hands to its episode through ``episode_fluid``.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from layered_swim.analysis import report
@@ -27,12 +31,18 @@ class Outcome:
 
 
 def run_experiment(module, out_dir: str | Path, quick: bool = False, workers: int = 2, progress: bool = False,
-                   seed: int = 0) -> dict:
+                   seed: int = 0, backend: str = "plate", fluid_settings=None) -> dict:
     if not isinstance(seed, int) or seed < 0:
         raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+    backends = getattr(module, "BACKENDS", ("plate",))
+    if backend not in backends:
+        raise ConfigError(f"experiment {module.NAME} runs on the {' and '.join(backends)} backend only, not {backend}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     configs = module.configs(quick, seed)
+    if backend != "plate":      # plate configs stay as they were: their cached results still count
+        fluid = asdict(fluid_settings) if fluid_settings is not None else None
+        configs = [{**config, "backend": backend, "fluid": fluid} for config in configs]
     results = run_sweep(module.run, configs, out / "cache", workers, progress, desc=module.NAME)
     outcome = module.finish(configs, results, out)
     write_json(out / "config.json", {COMMAND_KEY: "experiment", "experiment": module.NAME, "quick": quick, "seed": seed, "runs": configs,
@@ -43,3 +53,14 @@ def run_experiment(module, out_dir: str | Path, quick: bool = False, workers: in
     write_text(out / "report.md", report.experiment_report(module.TITLE, module.FIGURE, module.CSV, module.PAPER,
                                                            outcome.ours, outcome.setting, outcome.differs))
     return {**summary, "files": [module.FIGURE, module.CSV, "summary.json", "config.json", "report.md"]}
+
+
+def episode_fluid(config: dict) -> dict:
+    """The ``backend`` and ``fluid_settings`` arguments of an ``Episode`` for this config."""
+    backend = config.get("backend", "plate")
+    fluid = config.get("fluid")
+    if backend != "sph" or fluid is None:
+        return {"backend": backend}
+    from layered_swim.fluid.sph import SphSettings
+
+    return {"backend": backend, "fluid_settings": SphSettings(**{**fluid, "pool_size_m": tuple(fluid["pool_size_m"])})}
