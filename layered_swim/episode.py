@@ -15,7 +15,8 @@ After dm_control's Physics / Task / Environment split and Gymnasium's ``reset(se
 Which controller drives the swimmer: ``weights`` (a scripted per-cycle policy) gives the
 layered controller with those weights; otherwise a task without a target gets the basic stroke
 alone, and a task with one gets the layered controller steering toward it (``layers`` says
-which layers are on; the per-cycle layer reads the stroke's calibration table).
+which layers are on; the per-cycle layer reads the stroke's calibration table). ``wrap`` puts
+another controller around that one (the RL environment's learned residual).
 """
 from __future__ import annotations
 
@@ -42,7 +43,7 @@ from layered_swim.control.targets import Target
 from layered_swim.fluid import make_fluid
 from layered_swim.fluid.medium import Medium
 from layered_swim.sim.simulation import SimConfig, Simulation
-from layered_swim.state import BodyState, Start
+from layered_swim.state import BodyState, JointLayout, Start
 from layered_swim.tasks import Task
 
 Observer = Callable[[Simulation], None]
@@ -52,7 +53,8 @@ class Episode:
     def __init__(self, stroke: str, task: Task | None = None, *, medium: Medium = Medium(), backend: str = "plate",
                  fluid_settings=None, lung_air_l: float | None = None, physics_hz: int = 480, tempo: float = 1.0,
                  layers: Layers = Layers(), weights: WeightPolicy | None = None,
-                 tempo_control: TempoControl | None = None, seed: int = 0):
+                 tempo_control: TempoControl | None = None, seed: int = 0,
+                 wrap: Callable[[object, JointLayout], object] | None = None):
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
             raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
         self.task = task if task is not None else Task()     # swim the stroke; nothing asked, nothing sampled
@@ -64,6 +66,8 @@ class Episode:
         self.stroke: Stroke = build_stroke(self.stroke_spec, layout, str(path))
         controller = _controller(self.stroke, self.body, layout, self.task.target, layers, weights, tempo,
                                  tempo_control)
+        if wrap is not None:          # e.g. a learned residual on top (control/residual.py)
+            controller = wrap(controller, layout)
         config = SimConfig(physics_hz=physics_hz)
         fluid = make_fluid(backend, self.body, medium, config.gravity_m_s2, fluid_settings)
         self.sim = Simulation(self.body, controller, fluid, config, layout, self.stroke.pd_gain_scale)

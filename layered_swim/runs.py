@@ -266,10 +266,11 @@ def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = L
 
 
 def goal_episode(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layers = Layers(),
-                 backend: str = "plate", fluid_settings=None) -> Episode:
-    """An episode of SWIM's goal reaching in ``pool_name``; ``reset(goal=k)`` picks the goal."""
+                 backend: str = "plate", fluid_settings=None, wrap=None) -> Episode:
+    """An episode of SWIM's goal reaching in ``pool_name``; ``reset(goal=k)`` picks the goal.
+    ``wrap``: a controller around the layered one (``Episode``'s, e.g. a learned residual)."""
     return Episode(stroke, GoalReaching(bench.pool(pool_name)), medium=make_medium(current_m_s=current),
-                   layers=layers, tempo_control=GOAL_TEMPO, backend=backend, fluid_settings=fluid_settings)
+                   layers=layers, tempo_control=GOAL_TEMPO, backend=backend, fluid_settings=fluid_settings, wrap=wrap)
 
 
 def reach_goal(episode: Episode, goal: int, observers=()) -> dict:

@@ -1,0 +1,164 @@
+"""SWIM's goal reaching as a Gymnasium environment: a thin layer over the goal task and the
+episode runner. The policy acts at ``policy_hz`` (30) over the 480 Hz physics: each action is a
+residual added to the reference controller's joint targets (SWIM eq. 5) and held for the
+physics steps until the next one.
+
+- ``reference="basic"``: the stroke's key poses alone, SWIM's setting; ``"layered"``: the whole
+  layered controller (steering, rules) underneath.
+- Observation: ``observation.py`` (``env.layout`` names its slices). Action: one value in
+  [-1, 1] per pose coordinate (``env.action_names``), times ``action_scale_rad``.
+- Reward: SWIM's task x stability + smoothness (``reward.py``), every part in ``info["reward"]``.
+- The pool's horizon ends an episode by truncation. Leaving the pool, sinking to its floor or a
+  simulation that blows up terminates it, with the reason in ``info["termination"]``. The last
+  step's ``info["metrics"]`` holds the task's Pos, Prog, Dev and Roll.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from layered_swim.config import ConfigError
+from layered_swim.control.layered import Layers
+from layered_swim.control.residual import ResidualController
+from layered_swim.control.steering import attitude_of
+from layered_swim.fluid import FluidError
+from layered_swim.rl import observation as obs
+from layered_swim.rl.reward import BODY_POINT_WEIGHTS, RewardWeights, reward_parts
+from layered_swim.runs import goal_episode
+from layered_swim.sim.simulation import SimulationDiverged
+from layered_swim.tasks import swim_benchmark as bench
+
+REFERENCES = {"basic": "basic", "layered": "basic,cycle,rules"}
+
+
+class SwimGoalEnv(gym.Env):
+    metadata = {"render_modes": []}
+
+    def __init__(self, stroke: str = "front_crawl", pool: str = "small", reference: str = "basic",
+                 env_state: str = "SmoothFT", policy_hz: int = 30, action_scale_rad: float = 0.2,
+                 reward_weights: RewardWeights = RewardWeights(), backend: str = "plate", fluid_settings=None,
+                 current_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0), goal: int | None = None):
+        if reference not in REFERENCES:
+            raise ConfigError(f"reference must be one of {', '.join(REFERENCES)}, got {reference!r}")
+        if not (isinstance(action_scale_rad, (int, float)) and 0.0 < action_scale_rad <= 1.0):
+            raise ConfigError(f"action_scale_rad must be in (0, 1] rad, got {action_scale_rad!r}")
+        self.pool = bench.pool(pool)
+        self.reference, self.env_state, self.action_scale_rad = reference, env_state, float(action_scale_rad)
+        self.reward_weights, self.fixed_goal = reward_weights, goal
+        self.episode = goal_episode(pool, stroke, current_m_s, Layers.parse(REFERENCES[reference]), backend,
+                                    fluid_settings, wrap=ResidualController)
+        sim = self.episode.sim
+        if not (isinstance(policy_hz, int) and policy_hz > 0 and sim.config.physics_hz % policy_hz == 0
+                and (sim.config.physics_hz // policy_hz) % sim.control_every == 0):
+            raise ConfigError(f"policy_hz must divide the control rate {sim.config.control_hz} Hz, got {policy_hz!r}")
+        self.physics_per_action = sim.config.physics_hz // policy_hz
+        self.dt_s = 1.0 / policy_hz
+        self.stroke_name = stroke
+        self.roll_tolerance_rad = math.radians(bench.ROLL_TOLERANCE_DEG.get(self.episode.stroke.name, 45.0))
+        positions = sim.world.joint_positions()
+        _, rates = sim.world.joint_torques_and_rates()
+        self.layout = obs.layout_for(len(positions), len(rates), len(self.episode.body.segment_names), env_state)
+        self.action_names = tuple(sim.layout.names)
+        self.observation_space = gym.spaces.Box(-np.inf, np.inf, (self.layout.size,), np.float32)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (len(self.action_names),), np.float32)
+        self._links = [self.episode.body.index(name) for name in obs.TRACKED_LINKS]
+        self._body_point = {self.episode.body.index(name): w for name, w in BODY_POINT_WEIGHTS.items()}
+        self._smoothed = None
+        self._last_obs = np.zeros(self.layout.size, np.float32)
+
+    # -- Gymnasium ------------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        options = options or {}
+        goal = options.get("goal", self.fixed_goal)
+        if goal is None:
+            goal = int(self.np_random.integers(len(self.episode.task.goals)))
+        self.episode.reset(goal=goal)
+        self._smoothed = None
+        self._rates = self.episode.sim.world.joint_torques_and_rates()[1].copy()
+        sim = self.episode.sim
+        self._last_obs = self._observe(sim.fluid_now.force_n, sim.fluid_now.torque_nm)
+        return self._last_obs.copy(), {"goal": goal, "goal_m": list(self.episode.task.goal.goal_m)}
+
+    def step(self, action):
+        action = np.clip(np.asarray(action, dtype=float), -1.0, 1.0)
+        if action.shape != self.action_space.shape or not np.isfinite(action).all():
+            raise ValueError(f"action must be {self.action_space.shape} finite values, got shape {action.shape}")
+        episode, sim = self.episode, self.episode.sim
+        sim.controller.set_residual(self.action_scale_rad * action)
+        force, torque = np.zeros_like(sim.fluid_now.force_n), np.zeros_like(sim.fluid_now.torque_nm)
+        try:
+            for _ in range(self.physics_per_action):
+                episode.step()
+                force += sim.fluid_now.force_n
+                torque += sim.fluid_now.torque_nm
+        except (SimulationDiverged, FluidError) as err:
+            return self._last_obs.copy(), 0.0, True, False, {"termination": f"diverged: {err}"}
+        force /= self.physics_per_action
+        torque /= self.physics_per_action
+        self._last_obs = observation = self._observe(force, torque)
+        rates = sim.world.joint_torques_and_rates()[1]
+        parts = self._reward(observation, (rates - self._rates) / self.dt_s)
+        self._rates = rates.copy()
+        info: dict[str, Any] = {"reward": parts, "time_s": sim.time_s}
+        reason = self._failure(sim.state.com_m)
+        truncated = reason is None and sim.time_s >= self.pool.horizon_s - 1e-9
+        if reason is not None:
+            info["termination"] = reason
+        if reason is not None or truncated:
+            info["metrics"] = episode.metrics()
+        return observation.copy(), parts["total"], reason is not None, truncated, info
+
+    def close(self) -> None:
+        self.episode.close()
+
+    # -- parts --------------------------------------------------------------------------
+    def _frame(self):
+        state = self.episode.sim.state
+        return state, attitude_of(state, self.episode.stroke.start.posture)
+
+    def _observe(self, force_n: np.ndarray, torque_nm: np.ndarray) -> np.ndarray:
+        sim, layout = self.episode.sim, self.layout
+        state, att = self._frame()
+        heading = att.heading_rad
+        root = state.pos_m[0]
+        goals, _ = obs.local_goals(self._goals(), root, heading)
+        env, self._smoothed = obs.env_features(self.env_state, force_n, torque_nm, state.pos_m, state.com_m, heading,
+                                               self._smoothed)
+        _, rates = sim.world.joint_torques_and_rates()
+        parts = {
+            "root_height": [root[2]], "root_roll": [att.roll_rad],
+            "root_linvel": obs.to_heading_frame(state.linvel_m_s[0], heading),
+            "root_angvel": obs.to_heading_frame(state.angvel_rad_s[0], heading),
+            "link_pos": obs.to_heading_frame(state.pos_m[self._links] - root, heading).ravel(),
+            "link_vel": obs.to_heading_frame(state.linvel_m_s[self._links] - state.linvel_m_s[0], heading).ravel(),
+            "joint_pos": sim.world.joint_positions(), "joint_vel": rates,
+            "phase": obs.phase_encoding(sim.controller.phase(sim.time_s)), "goals": goals.ravel(), "env": env,
+        }
+        vector = np.empty(layout.size, np.float32)
+        for name, where in layout.slices.items():
+            vector[where] = parts[name]
+        return vector
+
+    def _goals(self) -> np.ndarray:
+        return bench.intermediate_goals(self.episode.task.goal, self.episode.sim.time_s, self.episode.stroke.period_s)
+
+    def _reward(self, observation: np.ndarray, joint_accel: np.ndarray) -> dict:
+        state, att = self._frame()
+        task = self.episode.task.goal
+        body_point = sum(w * state.pos_m[k] for k, w in self._body_point.items())
+        _, yaws = obs.local_goals(self._goals(), state.pos_m[0], att.heading_rad)
+        return reward_parts(bench.goal_position(task, state.time_s), state.pos_m[0], body_point, task.start_m,
+                            task.direction, yaws, att.roll_rad, self.roll_tolerance_rad, joint_accel,
+                            self.reward_weights)
+
+    def _failure(self, com_m: np.ndarray) -> str | None:
+        x0, x1 = self.pool.x_range_m
+        if not (x0 < com_m[0] < x1 and abs(com_m[1]) < self.pool.width_m / 2):
+            return f"left the {self.pool.name} pool (centre of mass at x = {com_m[0]:.2f}, y = {com_m[1]:.2f} m)"
+        if com_m[2] < -self.pool.depth_m:
+            return f"sank to the floor of the {self.pool.depth_m:g} m deep pool"
+        return None
