@@ -85,6 +85,9 @@ def _parser() -> argparse.ArgumentParser:
     goal.add_argument("--stroke", default="front_crawl")
     steering_options(goal, density=False)
     goal.add_argument("--json", action="store_true")
+    goal.add_argument("--policy", metavar="FILE", help="a trained residual (policy.pt from `train`) on its reference "
+                                                        "controller, the heuristic beside it")
+    goal.add_argument("--seeds", type=int, default=5, help="starts per goal with --policy (0: SWIM's fixed start; default 5)")
     _backend_option(goal, pool=None)
 
     render = sub.add_parser("render", help="draw a run folder or a trajectory swim to a video or PNG frames, no display needed")
@@ -127,6 +130,20 @@ def _parser() -> argparse.ArgumentParser:
     experiment.add_argument("--seed", type=int, default=0, help="seed of the random pushes (perturbation)")
     experiment.add_argument("--json", action="store_true", help="print the experiment's summary as one JSON object")
     _backend_option(experiment, pool="large")     # only hand-force runs in SPH water (`experiment list`)
+
+    train = sub.add_parser("train", help="train a residual policy with PPO on SWIM's goal task ([rl] extra)")
+    train.add_argument("--config", metavar="FILE", help="training YAML (default: the shipped front-crawl one)")
+    train.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help="override a field, e.g. --set ppo.learning_rate=1e-4 (repeatable)")
+    train.add_argument("--samples", type=int, help="environment steps in all (run.samples)")
+    train.add_argument("--workers", type=int, help="rollout worker processes (run.workers; default 2)")
+    train.add_argument("--buffer", choices=("fifo", "progevict"), help="episode buffer eviction (buffer.policy)")
+    train.add_argument("--ray", metavar="ADDRESS", help="run the rollout workers on a Ray cluster ('local': start one here)")
+    train.add_argument("--out", help="output folder (default runs/train-<stroke>)")
+    train.add_argument("--resume", action="store_true", help="continue the training in --out from its checkpoint")
+    _overwrite_option(train)
+    train.add_argument("--no-progress", action="store_true", help="no progress bar")
+    train.add_argument("--json", action="store_true", help="print the summary as one JSON object")
 
     soak = sub.add_parser("soak", help="swim for hours with the log streaming to disk, sampling memory: "
                                        "reports RSS growth and whether everything stayed finite")
@@ -414,6 +431,8 @@ def _cmd_goal(args) -> None:
     from layered_swim.tasks.goal import GOAL_METRICS
 
     current, layers = _vector(args.current, "--current"), Layers.parse(args.layers)
+    if args.policy:
+        return _goal_policy(args, current, layers)
     result = goal_run(args.pool, args.stroke, current, layers, args.backend, _fluid_settings(args))
     if args.backend != "plate":     # the same task on the plates, beside (seconds, against minutes)
         plate = goal_run(args.pool, args.stroke, current, layers)
@@ -426,6 +445,67 @@ def _cmd_goal(args) -> None:
     if "plate" in result:
         rows.append(["mean (plate)"] + [f"{result['plate'][k]:.3f}" for k in GOAL_METRICS])
     print(_table(rows, ["", "Pos m", "Prog", "Dev m", "Roll deg"]))
+
+
+def _goal_policy(args, current, layers) -> None:
+    import numpy as np
+
+    from layered_swim.config import ConfigError
+    from layered_swim.rl.policy import Policy, evaluate_goals
+    from layered_swim.runs import goal_run
+    from layered_swim.tasks.goal import GOAL_METRICS
+
+    policy = Policy.load(args.policy)
+    if args.stroke != policy.env["stroke"] and args.stroke != "front_crawl":
+        raise ConfigError(f"{args.policy} was trained for {policy.env['stroke']}, not {args.stroke}")
+    if not 1 <= args.seeds <= 100:
+        raise ConfigError(f"--seeds must be in 1..100, got {args.seeds}")
+    result = evaluate_goals(policy, args.seeds, pool=args.pool, backend=args.backend,
+                            fluid_settings=_fluid_settings(args), current_m_s=tuple(current))
+    heuristic = goal_run(args.pool, policy.env["stroke"], current, layers, args.backend, _fluid_settings(args))
+    result = {"policy": args.policy, "pool": args.pool, "stroke": policy.env["stroke"], "reference": policy.env["reference"],
+              "fluid_backend": args.backend, "current_m_s": list(current), "seeds": args.seeds, **result,
+              "heuristic": {k: heuristic[k] for k in GOAL_METRICS}, "swim_published": heuristic["swim_published"]}
+    if args.json:
+        print(json.dumps(result, allow_nan=False))
+        return
+    rows = []
+    for goal in sorted({r["goal"] for r in result["runs"]}):
+        runs = [r for r in result["runs"] if r["goal"] == goal and "pos_m" in r]
+        rows.append([f"goal {goal}"] + [f"{np.mean([r[k] for r in runs]):.3f}" if runs else "-" for k in GOAL_METRICS])
+    rows.append(["mean (policy)"] + [_fmt(result[k]) for k in GOAL_METRICS])
+    rows.append(["heuristic (layered)"] + [_fmt(result["heuristic"][k]) for k in GOAL_METRICS])
+    print(_table(rows, ["", "Pos m", "Prog", "Dev m", "Roll deg"]))
+    if result["terminated"]:
+        print(f"{result['terminated']} of {len(result['runs'])} episodes ended early (left the pool or sank)")
+
+
+def _cmd_train(args) -> None:
+    from layered_swim.config import ConfigError
+    from layered_swim.rl.config import load_train_spec
+    from layered_swim.rl.train import CHECKPOINT, train
+
+    overrides = list(args.set)
+    for key, value in (("run.samples", args.samples), ("run.workers", args.workers), ("buffer.policy", args.buffer)):
+        if value is not None:
+            overrides.append(f"{key}={value}")
+    spec = load_train_spec(args.config, overrides)
+    default = Path("runs") / f"train-{spec.env.stroke}"
+    if args.resume:
+        out = Path(args.out or default)
+        if not (out / CHECKPOINT).is_file():
+            raise ConfigError(f"{out}: nothing to resume (no {CHECKPOINT})")
+    else:
+        out = _out_dir(args, default)
+        if (out / CHECKPOINT).is_file() and not args.overwrite:
+            raise ConfigError(f"{out}: holds a training run; add --resume to continue it or --overwrite to start over")
+    say = None if args.json or _progress(args) else (lambda text: print(text, file=sys.stderr))
+    result = train(spec, out, resume=args.resume, progress=_progress(args), ray_address=args.ray, say=say)
+    if args.json:
+        print(json.dumps(result, allow_nan=False))
+        return
+    print(f"trained {result['samples']} samples in {result['epochs']} epochs ({result['wall_s']:.0f} s); "
+          f"policy: {result['policy']}")
 
 
 def _cmd_render(args) -> None:
@@ -530,7 +610,7 @@ def _cmd_experiment(args) -> None:
 COMMANDS = {"run": _cmd_run, "strokes": _cmd_strokes, "validate": _cmd_validate, "bench": _cmd_bench,
             "calibrate": _cmd_calibrate, "follow": _cmd_follow, "goal": _cmd_goal, "analyze": _cmd_analyze,
             "compare": _cmd_compare, "experiment": _cmd_experiment, "render": _cmd_render,
-            "soak": _cmd_soak}
+            "soak": _cmd_soak, "train": _cmd_train}
 
 
 def main(argv: list[str] | None = None) -> int:

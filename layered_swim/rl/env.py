@@ -5,6 +5,9 @@ physics steps until the next one.
 
 - ``reference="basic"``: the stroke's key poses alone, SWIM's setting; ``"layered"``: the whole
   layered controller (steering, rules) underneath.
+- ``reset(options={"goal": k, "start_seed": s})`` picks the goal (else drawn) and the start:
+  seed 0 is SWIM's fixed start, others jitter it (``episode.jittered_start``); with
+  ``start_jitter`` every reset draws a jittered start.
 - Observation: ``observation.py`` (``env.layout`` names its slices). Action: one value in
   [-1, 1] per pose coordinate (``env.action_names``), times ``action_scale_rad``.
 - Reward: SWIM's task x stability + smoothness (``reward.py``), every part in ``info["reward"]``.
@@ -40,14 +43,15 @@ class SwimGoalEnv(gym.Env):
     def __init__(self, stroke: str = "front_crawl", pool: str = "small", reference: str = "basic",
                  env_state: str = "SmoothFT", policy_hz: int = 30, action_scale_rad: float = 0.2,
                  reward_weights: RewardWeights = RewardWeights(), backend: str = "plate", fluid_settings=None,
-                 current_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0), goal: int | None = None):
+                 current_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0), goal: int | None = None,
+                 start_jitter: bool = False):
         if reference not in REFERENCES:
             raise ConfigError(f"reference must be one of {', '.join(REFERENCES)}, got {reference!r}")
         if not (isinstance(action_scale_rad, (int, float)) and 0.0 < action_scale_rad <= 1.0):
             raise ConfigError(f"action_scale_rad must be in (0, 1] rad, got {action_scale_rad!r}")
         self.pool = bench.pool(pool)
         self.reference, self.env_state, self.action_scale_rad = reference, env_state, float(action_scale_rad)
-        self.reward_weights, self.fixed_goal = reward_weights, goal
+        self.reward_weights, self.fixed_goal, self.start_jitter = reward_weights, goal, start_jitter
         self.episode = goal_episode(pool, stroke, current_m_s, Layers.parse(REFERENCES[reference]), backend,
                                     fluid_settings, wrap=ResidualController)
         sim = self.episode.sim
@@ -76,7 +80,8 @@ class SwimGoalEnv(gym.Env):
         goal = options.get("goal", self.fixed_goal)
         if goal is None:
             goal = int(self.np_random.integers(len(self.episode.task.goals)))
-        self.episode.reset(goal=goal)
+        start_seed = options.get("start_seed", int(self.np_random.integers(1, 2**31)) if self.start_jitter else 0)
+        self.episode.reset(seed=start_seed, goal=goal)      # seed 0: exactly SWIM's start; others jitter it
         self._smoothed = None
         self._rates = self.episode.sim.world.joint_torques_and_rates()[1].copy()
         sim = self.episode.sim

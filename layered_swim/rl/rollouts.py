@@ -1,0 +1,123 @@
+"""Collecting episodes with the current policy: in this process, in local worker processes (one
+per core by default), or on a Ray cluster (``--ray ADDRESS``, the ``[ray]`` extra). Each episode
+has its own seed, so a run is the same however many workers ran it, wherever."""
+from __future__ import annotations
+
+from concurrent.futures import ProcessPoolExecutor
+import multiprocessing
+
+import numpy as np
+import torch
+
+from layered_swim.config import ConfigError
+from layered_swim.rl.buffer import EpisodeData
+from layered_swim.rl.ppo import ActorCritic, Normaliser
+
+RAY_INSTALL = "pip install -e '.[ray]'"
+
+
+def make_env(env_kwargs: dict):
+    from layered_swim.rl.env import SwimGoalEnv
+
+    return SwimGoalEnv(**env_kwargs)
+
+
+def play(env, model: ActorCritic, normaliser: Normaliser, seeds: list[int], deterministic: bool = False,
+         options: list[dict] | None = None) -> list[EpisodeData]:
+    """One episode of ``model`` in ``env`` per seed (which seeds the reset and the action noise;
+    ``options[i]`` goes to reset i, where given)."""
+    episodes = []
+    for i, seed in enumerate(seeds):
+        generator = torch.Generator().manual_seed(int(seed))
+        obs, _ = env.reset(seed=int(seed), options=options[i] if options else None)
+        rows: dict[str, list] = {"obs": [], "actions": [], "log_probs": [], "rewards": []}
+        while True:
+            action, log_prob = model.act(normaliser(obs), deterministic, generator)
+            next_obs, reward, terminated, truncated, info = env.step(action)
+            for name, value in zip(rows, (obs, action, log_prob, reward)):
+                rows[name].append(value)
+            obs = next_obs
+            if terminated or truncated:
+                break
+        episodes.append(EpisodeData(np.array(rows["obs"], np.float32), np.array(rows["actions"], np.float32),
+                                    np.array(rows["log_probs"]), np.array(rows["rewards"]), obs.astype(np.float32),
+                                    bool(truncated), info={k: info[k] for k in ("metrics", "termination") if k in info}))
+    return episodes
+
+
+# -- one chunk, wherever it runs: the env is built once per worker and kept ----------------
+_ENV = None
+
+
+def _worker_init(env_kwargs: dict) -> None:
+    global _ENV
+    torch.set_num_threads(1)          # one core each: the workers are the parallelism
+    _ENV = make_env(env_kwargs)
+
+
+def _chunk(model_args: tuple, model_state: dict, normaliser_state: dict, seeds: list[int]):
+    model = ActorCritic(*model_args)
+    model.load_state_dict(model_state)
+    normaliser = Normaliser(model_args[0])
+    normaliser.load_state_dict(normaliser_state)
+    return play(_ENV, model, normaliser, seeds)
+
+
+class Rollouts:
+    """``collect(model, normaliser, n_episodes, seed)`` spread over ``workers``; ``ray_address``
+    sends the chunks to a Ray cluster instead ("local" starts one on this machine)."""
+
+    def __init__(self, env_kwargs: dict, workers: int, ray_address: str | None = None):
+        self.workers, self._pool, self._ray = workers, None, None
+        if ray_address:
+            try:
+                import ray
+            except ImportError:
+                raise ConfigError(f"--ray needs the [ray] extra: {RAY_INSTALL}") from None
+            if not ray.is_initialized():
+                ray.init(address=None if ray_address == "local" else ray_address, num_cpus=workers
+                         if ray_address == "local" else None, include_dashboard=False, log_to_driver=False)
+            actor = ray.remote(num_cpus=1)(_RayWorker)
+            self._ray = [actor.remote(env_kwargs) for _ in range(workers)]
+        elif workers > 1:
+            context = multiprocessing.get_context("spawn")     # PyBullet and torch threads do not survive fork
+            self._pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_worker_init,
+                                             initargs=(env_kwargs,))
+        else:
+            _worker_init(env_kwargs)
+
+    def collect(self, model: ActorCritic, model_args: tuple, normaliser: Normaliser,
+                seeds: list[int]) -> list[EpisodeData]:
+        """One episode per seed, in the seeds' order."""
+        state = {k: v.detach().clone() for k, v in model.state_dict().items()}
+        chunks = [seeds[k::self.workers] for k in range(self.workers)]
+        args = [(model_args, state, normaliser.state_dict(), chunk) for chunk in chunks if chunk]
+        if self._ray is not None:
+            import ray
+
+            results = ray.get([w.chunk.remote(*a) for w, a in zip(self._ray, args)])
+        elif self._pool is not None:
+            results = list(self._pool.map(_chunk, *zip(*args)))
+        else:
+            results = [_chunk(*a) for a in args]
+        by_seed = {}
+        for chunk, episodes in zip((a[-1] for a in args), results):
+            by_seed.update(zip(chunk, episodes))
+        return [by_seed[seed] for seed in seeds]
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(cancel_futures=True)
+        if self._ray is not None:
+            import ray
+
+            for worker in self._ray:
+                ray.kill(worker)
+
+
+class _RayWorker:
+    def __init__(self, env_kwargs: dict):
+        _worker_init(env_kwargs)
+
+    def chunk(self, *args):
+        return _chunk(*args)

@@ -1,0 +1,149 @@
+"""The trainer: ProgEvict against eqs. 16-20 on a toy buffer, GAE and the normaliser by hand,
+checkpoints (save -> load -> the same actions), resume, the command line, and Ray."""
+import csv
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import torch
+
+from layered_swim.config import ConfigError
+from layered_swim.rl.buffer import EpisodeBuffer, EpisodeData, EvictionSettings, eviction_probabilities, transition
+from layered_swim.rl.config import load_train_spec
+from layered_swim.rl.policy import Policy
+from layered_swim.rl.ppo import Normaliser, gae
+from layered_swim.rl.train import Trainer, train
+
+TINY = ["run.episodes_per_epoch=2", "run.samples=150", "run.workers=1", "run.eval_every=100", "ppo.hidden=[16, 16]",
+        "ppo.minibatch=64", "ppo.epochs=2"]
+
+
+def test_progevict_probabilities_follow_the_equations():
+    s = EvictionSettings(e_mid=0.0, k=1.0, w_age=0.5, w_reward=0.5, sigma=0.5)
+    p = eviction_probabilities([0, 0, 1, 2], [5.0, 1.0, 3.0, 2.0], current_epoch=2, s=s)
+    t = 1 / (1 + math.exp(2.0))                                   # eq. 17 at e = 2
+    age = np.array([9.0, 9.0, 4.0, 1.0]) / 23.0                   # eq. 19: (2 - e_i + 1)^2
+    z = np.array([1.0, -1.0, 1 / 3, -1 / 3])                      # ranks 3, 0, 2, 1 (eq. 20)
+    reward = np.exp(-z**2 / 0.5)
+    reward /= reward.sum()
+    fifo = np.array([1.0, 0.0, 0.0, 0.0])                         # the oldest, first inserted
+    assert p == pytest.approx(t * fifo + (1 - t) * (0.5 * age + 0.5 * reward))
+    assert p.sum() == pytest.approx(1.0)
+    assert transition(-50, s) == pytest.approx(1.0) and transition(50, s) == pytest.approx(0.0, abs=1e-12)
+
+
+def _episode(ret: float) -> EpisodeData:
+    return EpisodeData(np.zeros((1, 2), np.float32), np.zeros((1, 1), np.float32), np.zeros(1), np.array([ret]),
+                       np.zeros(2, np.float32), True)
+
+
+def test_fifo_evicts_the_oldest_and_late_progevict_keeps_the_best_and_the_worst():
+    fifo = EpisodeBuffer(3, "fifo")
+    rng = np.random.default_rng(0)
+    fifo.add([_episode(r) for r in (1.0, 2.0)], 0, rng)
+    assert fifo.add([_episode(r) for r in (3.0, 4.0)], 1, rng) == 1
+    assert [e.episode_return for e in fifo.episodes] == [2.0, 3.0, 4.0]
+    kept = {r: 0 for r in range(9)}
+    for seed in range(200):
+        late = EpisodeBuffer(8, "progevict", EvictionSettings(e_mid=0.0, k=1.0, w_age=0.0, w_reward=1.0))
+        late.add([_episode(float(r)) for r in range(9)], 100, np.random.default_rng(seed))
+        for e in late.episodes:
+            kept[int(e.episode_return)] += 1
+    assert kept[0] > kept[4] and kept[8] > kept[4]        # middling returns go first
+
+
+def test_gae_by_hand():
+    rewards, values = np.array([1.0, 2.0]), np.array([0.5, 1.0])
+    gamma, lam = 0.9, 0.8
+    d1 = 2.0 + gamma * 3.0 - 1.0                          # bootstrapped from V(final) = 3 (truncated)
+    d0 = 1.0 + gamma * 1.0 - 0.5
+    assert gae(rewards, values, 3.0, gamma, lam) == pytest.approx([d0 + gamma * lam * d1, d1])
+    assert gae(rewards, values, 0.0, gamma, lam)[1] == pytest.approx(2.0 - 1.0)   # terminated: no future
+
+
+def test_normaliser_merges_batches_exactly():
+    x = np.random.default_rng(1).normal(3.0, 2.0, (500, 4))
+    n = Normaliser(4)
+    n.update(x[:123])
+    n.update(x[123:])
+    assert n.mean == pytest.approx(x.mean(axis=0), rel=1e-6) and n.var == pytest.approx(x.var(axis=0), rel=1e-3)
+
+
+def test_bad_training_config_is_one_line():
+    with pytest.raises(ConfigError, match="ppo.learning_rate"):
+        load_train_spec(None, ["ppo.learning_rate=-1"])
+    with pytest.raises(ConfigError, match="run.workers"):
+        load_train_spec(None, ["run.workers=0"])
+    with pytest.raises(ConfigError, match="key=value"):
+        load_train_spec(None, ["samples"])
+
+
+def _rows(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def test_checkpoint_policy_and_resume(tmp_path):
+    spec = load_train_spec(None, TINY)
+    first = train(spec, tmp_path / "a", say=None)
+    assert first["samples"] >= 150
+    # The policy file gives the trainer's actions and normaliser back.
+    trainer = Trainer(spec, tmp_path / "a")
+    trainer.resume()
+    policy = Policy.load(tmp_path / "a" / "policy.pt")
+    assert policy.normaliser.mean == pytest.approx(trainer.normaliser.mean)
+    obs = np.random.default_rng(2).normal(size=(5, trainer.model_args[0])).astype(np.float32)
+    for o in obs:
+        a, _ = trainer.model.act(trainer.normaliser(o), True)
+        b, _ = policy.model.act(policy.normaliser(o), True)
+        assert np.array_equal(a, b)
+    # Resuming with more samples continues the count and gives what one long run gives.
+    longer = load_train_spec(None, TINY + ["run.samples=400"])
+    resumed = train(longer, tmp_path / "a", resume=True, say=None)
+    straight = train(longer, tmp_path / "b", say=None)
+    assert resumed["samples"] == straight["samples"] > first["samples"]
+    a_rows, b_rows = _rows(tmp_path / "a" / "progress.csv"), _rows(tmp_path / "b" / "progress.csv")
+    assert [r["samples"] for r in a_rows] == [r["samples"] for r in b_rows]
+    assert [r["mean_return"] for r in a_rows] == [r["mean_return"] for r in b_rows]
+    with pytest.raises(ConfigError, match="another configuration"):
+        Trainer(load_train_spec(None, TINY + ["ppo.clip=0.1"]), tmp_path / "a").resume()
+
+
+def test_a_damaged_policy_file_is_one_line(tmp_path):
+    (tmp_path / "p.pt").write_bytes(b"not a policy")
+    with pytest.raises(ConfigError, match="not a layered-swim policy file"):
+        Policy.load(tmp_path / "p.pt")
+    with pytest.raises(ConfigError, match="no such policy file"):
+        Policy.load(tmp_path / "none.pt")
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "layered_swim", *args], capture_output=True, text=True, timeout=600)
+
+
+def test_cli_train_then_goal_with_the_policy(tmp_path):
+    out = tmp_path / "t"
+    sets = [x for item in TINY for x in ("--set", item)]
+    done = _cli("train", *sets, "--samples", "150", "--out", str(out), "--no-progress", "--json")
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["samples"] >= 150
+    assert json.loads((out / "config.json").read_text())["command"] == "train"
+    again = _cli("train", *sets, "--out", str(out), "--no-progress")
+    assert again.returncode == 2 and "--resume" in again.stderr and len(again.stderr.strip().splitlines()) == 1
+    goal = _cli("goal", "--policy", str(out / "policy.pt"), "--seeds", "1", "--json")
+    assert goal.returncode == 0, goal.stderr
+    result = json.loads(goal.stdout)
+    assert len(result["runs"]) == 3 and set(result["heuristic"]) == {"pos_m", "prog", "dev_m", "roll_deg"}
+    bad = _cli("goal", "--policy", str(tmp_path / "missing.pt"))
+    assert bad.returncode == 2 and "no such policy file" in bad.stderr
+
+
+def test_ray_workers_give_the_local_result(tmp_path):
+    pytest.importorskip("ray")
+    spec = load_train_spec(None, TINY + ["run.workers=2"])
+    on_ray = train(spec, tmp_path / "ray", ray_address="local", say=None)
+    local = train(spec, tmp_path / "local", say=None)
+    assert on_ray["last"]["mean_return"] == local["last"]["mean_return"]
