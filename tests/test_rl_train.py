@@ -14,7 +14,7 @@ from layered_swim.config import ConfigError
 from layered_swim.rl.buffer import EpisodeBuffer, EpisodeData, EvictionSettings, eviction_probabilities, transition
 from layered_swim.rl.config import load_train_spec
 from layered_swim.rl.policy import Policy
-from layered_swim.rl.ppo import Normaliser, gae
+from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, Normaliser, gae
 from layered_swim.rl.train import Trainer, train
 
 TINY = ["run.episodes_per_epoch=2", "run.samples=150", "run.workers=1", "run.eval_every=100", "ppo.hidden=[16, 16]",
@@ -64,6 +64,19 @@ def test_gae_by_hand():
     assert gae(rewards, values, 0.0, gamma, lam)[1] == pytest.approx(2.0 - 1.0)   # terminated: no future
 
 
+def test_the_numpy_actor_matches_the_torch_distribution():
+    torch.manual_seed(0)
+    model = ActorCritic(6, 3, (8,), init_log_std=-0.5)
+    with torch.no_grad():
+        model.actor[-1].weight.normal_()
+    snapshot = ActorSnapshot(model)
+    obs = np.random.default_rng(3).normal(size=6).astype(np.float32)
+    action, log_prob = snapshot.act(obs, False, np.random.default_rng(4))
+    dist = model.distribution(torch.as_tensor(obs)[None])
+    assert snapshot.act(obs, True)[0] == pytest.approx(dist.mean[0].detach().numpy(), abs=1e-6)
+    assert log_prob == pytest.approx(float(dist.log_prob(torch.as_tensor(action)[None]).sum()), abs=1e-4)
+
+
 def test_normaliser_merges_batches_exactly():
     x = np.random.default_rng(1).normal(3.0, 2.0, (500, 4))
     n = Normaliser(4)
@@ -96,10 +109,9 @@ def test_checkpoint_policy_and_resume(tmp_path):
     policy = Policy.load(tmp_path / "a" / "policy.pt")
     assert policy.normaliser.mean == pytest.approx(trainer.normaliser.mean)
     obs = np.random.default_rng(2).normal(size=(5, trainer.model_args[0])).astype(np.float32)
+    mine, loaded = ActorSnapshot(trainer.model), ActorSnapshot(policy.model)
     for o in obs:
-        a, _ = trainer.model.act(trainer.normaliser(o), True)
-        b, _ = policy.model.act(policy.normaliser(o), True)
-        assert np.array_equal(a, b)
+        assert np.array_equal(mine.act(trainer.normaliser(o), True)[0], loaded.act(policy.normaliser(o), True)[0])
     # Resuming with more samples continues the count and gives what one long run gives.
     longer = load_train_spec(None, TINY + ["run.samples=400"])
     resumed = train(longer, tmp_path / "a", resume=True, say=None)

@@ -18,6 +18,7 @@ physics steps until the next one.
 from __future__ import annotations
 
 import math
+import time
 from typing import Any
 
 import gymnasium as gym
@@ -72,6 +73,9 @@ class SwimGoalEnv(gym.Env):
         self._body_point = {self.episode.body.index(name): w for name, w in BODY_POINT_WEIGHTS.items()}
         self._smoothed = None
         self._last_obs = np.zeros(self.layout.size, np.float32)
+        # Seconds spent stepping the physics and building observations and rewards, since
+        # construction (``bench --env`` reads them; four clock reads a step cost nothing).
+        self.timing = {"physics_s": 0.0, "observation_s": 0.0, "reward_s": 0.0}
 
     # -- Gymnasium ------------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
@@ -83,9 +87,9 @@ class SwimGoalEnv(gym.Env):
         start_seed = options.get("start_seed", int(self.np_random.integers(1, 2**31)) if self.start_jitter else 0)
         self.episode.reset(seed=start_seed, goal=goal)      # seed 0: exactly SWIM's start; others jitter it
         self._smoothed = None
-        self._rates = self.episode.sim.world.joint_torques_and_rates()[1].copy()
         sim = self.episode.sim
         self._last_obs = self._observe(sim.fluid_now.force_n, sim.fluid_now.torque_nm)
+        self._rates = self._now[3]
         return self._last_obs.copy(), {"goal": goal, "goal_m": list(self.episode.task.goal.goal_m)}
 
     def step(self, action):
@@ -95,6 +99,7 @@ class SwimGoalEnv(gym.Env):
         episode, sim = self.episode, self.episode.sim
         sim.controller.set_residual(self.action_scale_rad * action)
         force, torque = np.zeros_like(sim.fluid_now.force_n), np.zeros_like(sim.fluid_now.torque_nm)
+        clock = time.perf_counter()
         try:
             for _ in range(self.physics_per_action):
                 episode.step()
@@ -102,12 +107,18 @@ class SwimGoalEnv(gym.Env):
                 torque += sim.fluid_now.torque_nm
         except (SimulationDiverged, FluidError) as err:
             return self._last_obs.copy(), 0.0, True, False, {"termination": f"diverged: {err}"}
+        observed = time.perf_counter()
         force /= self.physics_per_action
         torque /= self.physics_per_action
         self._last_obs = observation = self._observe(force, torque)
-        rates = sim.world.joint_torques_and_rates()[1]
-        parts = self._reward(observation, (rates - self._rates) / self.dt_s)
-        self._rates = rates.copy()
+        rewarded = time.perf_counter()
+        rates = self._now[3]
+        parts = self._reward((rates - self._rates) / self.dt_s)
+        self._rates = rates
+        done = time.perf_counter()
+        self.timing["physics_s"] += observed - clock
+        self.timing["observation_s"] += rewarded - observed
+        self.timing["reward_s"] += done - rewarded
         info: dict[str, Any] = {"reward": parts, "time_s": sim.time_s}
         reason = self._failure(sim.state.com_m)
         truncated = reason is None and sim.time_s >= self.pool.horizon_s - 1e-9
@@ -121,44 +132,40 @@ class SwimGoalEnv(gym.Env):
         self.episode.close()
 
     # -- parts --------------------------------------------------------------------------
-    def _frame(self):
-        state = self.episode.sim.state
-        return state, attitude_of(state, self.episode.stroke.start.posture)
-
     def _observe(self, force_n: np.ndarray, torque_nm: np.ndarray) -> np.ndarray:
+        """The observation now; keeps what the reward needs of it (``self._now``)."""
         sim, layout = self.episode.sim, self.layout
-        state, att = self._frame()
+        state = sim.state
+        att = attitude_of(state, self.episode.stroke.start.posture)
         heading = att.heading_rad
         root = state.pos_m[0]
-        goals, _ = obs.local_goals(self._goals(), root, heading)
+        goals_m = bench.intermediate_goals(self.episode.task.goal, sim.time_s, self.episode.stroke.period_s)
+        goals, yaws = obs.local_goals(goals_m, root, heading)
         env, self._smoothed = obs.env_features(self.env_state, force_n, torque_nm, state.pos_m, state.com_m, heading,
                                                self._smoothed)
         _, rates = sim.world.joint_torques_and_rates()
+        links = obs.to_heading_frame(np.concatenate([state.pos_m[self._links] - root,
+                                                     state.linvel_m_s[self._links] - state.linvel_m_s[0],
+                                                     state.linvel_m_s[:1], state.angvel_rad_s[:1]]), heading)
+        n = len(self._links)
         parts = {
-            "root_height": [root[2]], "root_roll": [att.roll_rad],
-            "root_linvel": obs.to_heading_frame(state.linvel_m_s[0], heading),
-            "root_angvel": obs.to_heading_frame(state.angvel_rad_s[0], heading),
-            "link_pos": obs.to_heading_frame(state.pos_m[self._links] - root, heading).ravel(),
-            "link_vel": obs.to_heading_frame(state.linvel_m_s[self._links] - state.linvel_m_s[0], heading).ravel(),
+            "root_height": root[2], "root_roll": att.roll_rad, "root_linvel": links[2 * n], "root_angvel": links[2 * n + 1],
+            "link_pos": links[:n].ravel(), "link_vel": links[n:2 * n].ravel(),
             "joint_pos": sim.world.joint_positions(), "joint_vel": rates,
             "phase": obs.phase_encoding(sim.controller.phase(sim.time_s)), "goals": goals.ravel(), "env": env,
         }
         vector = np.empty(layout.size, np.float32)
         for name, where in layout.slices.items():
             vector[where] = parts[name]
+        self._now = (state, att.roll_rad, yaws, rates.copy())
         return vector
 
-    def _goals(self) -> np.ndarray:
-        return bench.intermediate_goals(self.episode.task.goal, self.episode.sim.time_s, self.episode.stroke.period_s)
-
-    def _reward(self, observation: np.ndarray, joint_accel: np.ndarray) -> dict:
-        state, att = self._frame()
+    def _reward(self, joint_accel: np.ndarray) -> dict:
+        state, roll, yaws, _ = self._now
         task = self.episode.task.goal
         body_point = sum(w * state.pos_m[k] for k, w in self._body_point.items())
-        _, yaws = obs.local_goals(self._goals(), state.pos_m[0], att.heading_rad)
         return reward_parts(bench.goal_position(task, state.time_s), state.pos_m[0], body_point, task.start_m,
-                            task.direction, yaws, att.roll_rad, self.roll_tolerance_rad, joint_accel,
-                            self.reward_weights)
+                            task.direction, yaws, roll, self.roll_tolerance_rad, joint_accel, self.reward_weights)
 
     def _failure(self, com_m: np.ndarray) -> str | None:
         x0, x1 = self.pool.x_range_m

@@ -9,7 +9,7 @@ import numpy as np
 import torch
 
 from layered_swim.config import ConfigError
-from layered_swim.rl.ppo import ActorCritic, Normaliser
+from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, Normaliser
 from layered_swim.rl.reward import RewardWeights
 from layered_swim.tasks.goal import GOAL_METRICS
 
@@ -60,7 +60,7 @@ def evaluate_goals(policy: Policy, seeds: int = 5, **env_changes) -> dict:
     try:
         goals = len(env.episode.task.goals)
         options = [{"goal": g, "start_seed": s} for g in range(goals) for s in range(seeds)]
-        episodes = play(env, policy.model, policy.normaliser, list(range(len(options))), True, options)
+        episodes = play(env, ActorSnapshot(policy.model), policy.normaliser, list(range(len(options))), True, options)
         for option, episode in zip(options, episodes):
             metrics = episode.info.get("metrics", {})
             runs.append({**option, **metrics, "steps": episode.steps, "return": episode.episode_return,

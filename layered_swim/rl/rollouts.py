@@ -11,7 +11,7 @@ import torch
 
 from layered_swim.config import ConfigError
 from layered_swim.rl.buffer import EpisodeData
-from layered_swim.rl.ppo import ActorCritic, Normaliser
+from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, Normaliser
 
 RAY_INSTALL = "pip install -e '.[ray]'"
 
@@ -22,17 +22,17 @@ def make_env(env_kwargs: dict):
     return SwimGoalEnv(**env_kwargs)
 
 
-def play(env, model: ActorCritic, normaliser: Normaliser, seeds: list[int], deterministic: bool = False,
+def play(env, actor: ActorSnapshot, normaliser: Normaliser, seeds: list[int], deterministic: bool = False,
          options: list[dict] | None = None) -> list[EpisodeData]:
-    """One episode of ``model`` in ``env`` per seed (which seeds the reset and the action noise;
+    """One episode of ``actor`` in ``env`` per seed (which seeds the reset and the action noise;
     ``options[i]`` goes to reset i, where given)."""
     episodes = []
     for i, seed in enumerate(seeds):
-        generator = torch.Generator().manual_seed(int(seed))
+        rng = np.random.default_rng(int(seed))
         obs, _ = env.reset(seed=int(seed), options=options[i] if options else None)
         rows: dict[str, list] = {"obs": [], "actions": [], "log_probs": [], "rewards": []}
         while True:
-            action, log_prob = model.act(normaliser(obs), deterministic, generator)
+            action, log_prob = actor.act(normaliser(obs), deterministic, rng)
             next_obs, reward, terminated, truncated, info = env.step(action)
             for name, value in zip(rows, (obs, action, log_prob, reward)):
                 rows[name].append(value)
@@ -60,7 +60,7 @@ def _chunk(model_args: tuple, model_state: dict, normaliser_state: dict, seeds: 
     model.load_state_dict(model_state)
     normaliser = Normaliser(model_args[0])
     normaliser.load_state_dict(normaliser_state)
-    return play(_ENV, model, normaliser, seeds)
+    return play(_ENV, ActorSnapshot(model), normaliser, seeds)
 
 
 class Rollouts:
