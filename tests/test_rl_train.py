@@ -159,3 +159,33 @@ def test_ray_workers_give_the_local_result(tmp_path):
     on_ray = train(spec, tmp_path / "ray", ray_address="local", say=None)
     local = train(spec, tmp_path / "local", say=None)
     assert on_ray["last"]["mean_return"] == local["last"]["mean_return"]
+
+
+def test_swim_table_quick_has_every_controller_and_swims_the_shipped_policy(tmp_path):
+    done = _cli("experiment", "swim-table", "--quick", "--out", str(tmp_path), "--no-progress", "--json")
+    assert done.returncode == 0, done.stderr
+    rows = {r["controller"]: r for r in json.loads(done.stdout)["rows"]}
+    assert set(rows) == {"basic stroke", "layered", "basic + residual", "layered + residual"}
+    assert rows["layered + residual"]["missing"] is None and 0 < rows["layered + residual"]["pos_m"] < 1.0
+    assert "no trained basic-reference policy" in rows["basic + residual"]["missing"]
+    assert (tmp_path / "swim_table.png").is_file() and "SWIM" in (tmp_path / "swim_table.csv").read_text()
+
+
+def test_pool_workers_end_with_a_killed_trainer():
+    import os
+    import signal
+    import time
+
+    code = ("import time\nfrom layered_swim.rl.rollouts import Rollouts\n"
+            "r = Rollouts({'env_state': 'NoEnv'}, 2)\nlist(r._pool.map(abs, [1, 2]))\n"
+            "print(' '.join(str(p) for p in r._pool._processes), flush=True)\ntime.sleep(120)\n")
+    parent = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    workers = [int(p) for p in parent.stdout.readline().split()]
+    os.kill(parent.pid, signal.SIGKILL)
+    parent.wait()
+    deadline = time.time() + 10
+    while time.time() < deadline and any(os.path.exists(f"/proc/{p}") and
+                                         open(f"/proc/{p}/stat").read().split()[2] != "Z" for p in workers):
+        time.sleep(0.2)
+    assert len(workers) == 2
+    assert not [p for p in workers if os.path.exists(f"/proc/{p}") and open(f"/proc/{p}/stat").read().split()[2] != "Z"]

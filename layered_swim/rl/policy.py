@@ -50,16 +50,17 @@ class Policy:
         return env
 
 
-def evaluate_goals(policy: Policy, seeds: int = 5, **env_changes) -> dict:
-    """The policy, deterministic, on each of the pool's goals from ``seeds`` starts (seed 0:
-    SWIM's fixed start; the others jittered): Pos, Prog, Dev and Roll per run and their means."""
+def evaluate_goals(policy: Policy, seeds: int = 5, goals: list[int] | None = None, **env_changes) -> dict:
+    """The policy, deterministic, on each of ``goals`` (default: all the pool's) from ``seeds``
+    starts (seed 0: SWIM's fixed start; the others jittered): Pos, Prog, Dev and Roll per run
+    and their means."""
     from layered_swim.rl.rollouts import make_env, play
 
     env = make_env(policy.env_kwargs(**{"start_jitter": False, **env_changes}))
     runs = []
     try:
-        goals = len(env.episode.task.goals)
-        options = [{"goal": g, "start_seed": s} for g in range(goals) for s in range(seeds)]
+        goals = range(len(env.episode.task.goals)) if goals is None else goals
+        options = [{"goal": g, "start_seed": s} for g in goals for s in range(seeds)]
         episodes = play(env, ActorSnapshot(policy.model), policy.normaliser, list(range(len(options))), True, options)
         for option, episode in zip(options, episodes):
             metrics = episode.info.get("metrics", {})

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from concurrent.futures import ProcessPoolExecutor
 import multiprocessing
+import signal
+import sys
 
 import numpy as np
 import torch
@@ -51,8 +53,19 @@ _ENV = None
 
 def _worker_init(env_kwargs: dict) -> None:
     global _ENV
+    _die_with_parent()
     torch.set_num_threads(1)          # one core each: the workers are the parallelism
     _ENV = make_env(env_kwargs)
+
+
+def _die_with_parent() -> None:
+    """A trainer killed outright (SIGKILL, OOM) would leave its pool's workers polling forever:
+    on Linux the kernel ends them with it."""
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        PR_SET_PDEATHSIG = 1
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 def _chunk(model_args: tuple, model_state: dict, normaliser_state: dict, seeds: list[int]):

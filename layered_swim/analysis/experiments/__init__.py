@@ -2,11 +2,11 @@
 from __future__ import annotations
 
 from layered_swim.analysis.experiments import (current_sweep, density_sweep, hand_force, layers_in_current,
-                                               palm_rule, perturbation, turn)
+                                               palm_rule, perturbation, swim_table, turn)
 from layered_swim.config import ConfigError
 
 EXPERIMENTS = {m.NAME: m for m in (hand_force, turn, palm_rule, layers_in_current, density_sweep, current_sweep,
-                                   perturbation)}
+                                   perturbation, swim_table)}
 
 
 def experiment(name: str):

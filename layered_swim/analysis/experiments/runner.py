@@ -43,10 +43,12 @@ def run_experiment(module, out_dir: str | Path, quick: bool = False, workers: in
     if backend != "plate":      # plate configs stay as they were: their cached results still count
         fluid = asdict(fluid_settings) if fluid_settings is not None else None
         configs = [{**config, "backend": backend, "fluid": fluid} for config in configs]
-    results = run_sweep(module.run, configs, out / "cache", workers, progress, desc=module.NAME)
-    outcome = module.finish(configs, results, out)
+    # config.json first: a sweep stopped halfway leaves a folder the next run recognises (and
+    # whose cache it reuses), not one it refuses as foreign.
     write_json(out / "config.json", {COMMAND_KEY: "experiment", "experiment": module.NAME, "quick": quick, "seed": seed, "runs": configs,
                                       "versions": versions()})
+    results = run_sweep(module.run, configs, out / "cache", workers, progress, desc=module.NAME)
+    outcome = module.finish(configs, results, out)
     summary = {"experiment": module.NAME, "title": module.TITLE, "paper": module.PAPER, "ours": outcome.ours,
                "differs": outcome.differs, "setting": outcome.setting, **outcome.numbers}
     write_json(out / "summary.json", summary)
