@@ -23,6 +23,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--backend", default="plate",
                    help="fluid model; the window runs only plate (SPH is ~20x slower than real time: use `layered-swim render --backend sph`)")
     steering_options(p)   # --layers (keys toggle them), --current, --density
+    p.add_argument("--policy", metavar="FILE", help="a trained residual (policy.pt from `layered-swim train`) drives "
+                                                     "its stroke (needs the [rl] extra)")
     p.add_argument("--size", default="1280x720", metavar="WxH", help="window size in pixels")
     p.add_argument("--capture-dir", default="captures", help="where screenshots and videos go (default captures/)")
     p.add_argument("--benchmark-frames", type=int, metavar="N",
@@ -49,8 +51,13 @@ def _open_window(args) -> None:
     width, height = _size(args.size)
     if args.benchmark_frames is not None and args.benchmark_frames < 2:
         raise ConfigError(f"--benchmark-frames must be at least 2, got {args.benchmark_frames}")
+    policy = None
+    if args.policy:
+        from layered_swim.rl.policy import Policy
+
+        policy = Policy.load(args.policy)
     session = SwimSession(args.stroke, Layers.parse(args.layers), _vector(args.current, "--current"), args.density,
-                          args.trajectory)
+                          args.trajectory, policy=policy)
     if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         session.close()
         raise ConfigError("no display to open a window on (run it on a desktop, or under xvfb-run); "

@@ -78,6 +78,8 @@ def _parser() -> argparse.ArgumentParser:
     follow.add_argument("--out", help="output folder (default runs/follow-<trajectory>-<timestamp>)")
     _overwrite_option(follow)
     follow.add_argument("--json", action="store_true")
+    follow.add_argument("--policy", metavar="FILE", help="a trained residual (policy.pt from `train`) on its reference "
+                                                          "controller (--layers then comes from the policy)")
     _backend_option(follow, pool="large")       # a trajectory's target starts 2 m ahead
 
     goal = sub.add_parser("goal", help="SWIM's goal-reaching benchmark (Pos, Prog, Dev, Roll)")
@@ -420,12 +422,25 @@ def _cmd_calibrate(args) -> None:
 
 
 def _cmd_follow(args) -> None:
+    from layered_swim.config import ConfigError
     from layered_swim.control.layered import Layers
     from layered_swim.runs import default_out_dir, follow_run
 
+    layers, steered = Layers.parse(args.layers), {}
+    if args.policy:        # the residual on its own reference controller, run by its driver
+        from layered_swim.control.residual import ResidualController
+        from layered_swim.rl.env import REFERENCES
+        from layered_swim.rl.policy import Policy, ResidualDriver
+
+        policy = Policy.load(args.policy)
+        if args.stroke != policy.env["stroke"]:
+            raise ConfigError(f"{args.policy} was trained for {policy.env['stroke']}; add --stroke {policy.env['stroke']}")
+        layers = Layers.parse(REFERENCES[policy.env["reference"]])
+        steered = {"wrap": ResidualController, "driver": lambda episode: ResidualDriver(policy, episode),
+                   "extra": {"policy": args.policy, "reference": policy.env["reference"]}}
     out = str(_out_dir(args, default_out_dir(f"follow-{Path(args.trajectory).stem}")))
-    result = follow_run(args.trajectory, args.stroke, Layers.parse(args.layers), _vector(args.current, "--current"),
-                        args.density, args.seconds, out, args.backend, _fluid_settings(args))
+    result = follow_run(args.trajectory, args.stroke, layers, _vector(args.current, "--current"),
+                        args.density, args.seconds, out, args.backend, _fluid_settings(args), **steered)
     if args.json:
         print(json.dumps({**result, "out_dir": out}, allow_nan=False))
         return

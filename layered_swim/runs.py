@@ -238,16 +238,20 @@ def _metrics(episode: Episode, stopped: BaseException | None) -> dict:
 
 def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = Layers(), current=(0.0, 0.0, 0.0),
                density: float | None = None, seconds: float = 60.0, out_dir: str | Path | None = None,
-               backend: str = "plate", fluid_settings=None) -> dict:
+               backend: str = "plate", fluid_settings=None, wrap=None, driver=None, extra: dict | None = None) -> dict:
+    """Follow ``trajectory``. ``wrap`` and ``driver`` put something else in charge of the
+    controller: ``wrap`` goes around it (``Episode``'s), ``driver(episode)`` makes an observer
+    that steers it every step (a learned residual's ``ResidualDriver``); ``extra`` joins the summary."""
     check_seconds(seconds)
     target = load_trajectory(trajectory)
     episode = Episode(stroke, FollowTarget(target), medium=make_medium(density_kg_m3=density, current_m_s=current),
-                      layers=layers, backend=backend, fluid_settings=fluid_settings)
+                      layers=layers, backend=backend, fluid_settings=fluid_settings, wrap=wrap)
     check_path_in_pool(episode, target, seconds)
+    observers = [driver(episode)] if driver is not None else []
     head = {"trajectory": target.name, "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
-            "seconds": seconds}
+            "seconds": seconds, **(extra or {})}
     if out_dir is None:
-        swim(episode, seconds)
+        swim(episode, seconds, observers)
         return {**head, **episode.metrics(), **fluid_report(episode)}
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -259,7 +263,7 @@ def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = L
                                                        "settings": episode.sim.fluid.settings()},
                                      "cycles_per_s_at_tempo_1": 1.0 / episode.stroke.period_s})
     try:
-        return logged_swim(episode, seconds, out, extra=head)
+        return logged_swim(episode, seconds, out, extra=head, observers=observers)
     finally:
         with atomic_path(out / "track.npz") as tmp:
             np.savez_compressed(tmp, **episode.task.track())

@@ -1,6 +1,7 @@
 """The app's parts that need no window: camera picking, scene geometry, the interactive session's
 clock and switches, the HUD text and the frame writer."""
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -167,3 +168,19 @@ def test_frame_writer_png_fallback(tmp_path):
     path = writer.close()
     frames = sorted(path.glob("frame_*.png"))
     assert [np.asarray(Image.open(f)).mean() for f in frames] == [0, 128]
+
+
+def test_a_shipped_policy_drives_the_session_and_the_hud_says_so():
+    from layered_swim.rl.policy import Policy
+    from layered_swim.render.hud import hud_lines
+
+    policy = Policy.load(Path(__file__).resolve().parents[1] / "layered_swim/rl/policies/front_crawl_layered.pt")
+    s = SwimSession("front_crawl", policy=policy)
+    s.step(64)
+    assert np.isfinite(s.com_m).all() and np.any(s.sim.controller.residual_rad != 0.0)
+    assert any("learned residual" in line for line in hud_lines(s, 60.0))
+    s.toggle_layer("palm")
+    assert "keeps the layers" in s.message
+    s.close()
+    with pytest.raises(ConfigError, match="trained for front_crawl"):
+        SwimSession("breaststroke", policy=policy)

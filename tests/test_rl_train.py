@@ -149,6 +149,13 @@ def test_cli_train_then_goal_with_the_policy(tmp_path):
     assert goal.returncode == 0, goal.stderr
     result = json.loads(goal.stdout)
     assert len(result["runs"]) == 3 and set(result["heuristic"]) == {"pos_m", "prog", "dev_m", "roll_deg"}
+    follow = _cli("follow", "straight_line", "--stroke", "front_crawl", "--seconds", "2", "--policy",
+                  str(out / "policy.pt"), "--out", str(tmp_path / "f"), "--json")
+    assert follow.returncode == 0, follow.stderr
+    followed = json.loads(follow.stdout)
+    assert followed["reference"] == "layered" and np.isfinite(followed["mean_distance_m"])
+    wrong = _cli("follow", "straight_line", "--seconds", "2", "--policy", str(out / "policy.pt"), "--out", str(tmp_path / "g"))
+    assert wrong.returncode == 2 and "--stroke front_crawl" in wrong.stderr
     bad = _cli("goal", "--policy", str(tmp_path / "missing.pt"))
     assert bad.returncode == 2 and "no such policy file" in bad.stderr
 

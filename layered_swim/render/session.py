@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from layered_swim.render.scene import Scene
+from layered_swim.config import ConfigError
 from layered_swim.control.calibration import CalibrationError
 from layered_swim.control.layered import Layers
 from layered_swim.control.steering import attitude_of
@@ -75,11 +76,17 @@ class ActiveTarget:
 class SwimSession:
     def __init__(self, stroke: str = "breaststroke", layers: Layers = Layers(), current_m_s=(0.0, 0.0, 0.0),
                  density_kg_m3: float | None = None, trajectory: str | None = None, physics_hz: int = 480,
-                 backend: str = "plate", fluid_settings=None):
+                 backend: str = "plate", fluid_settings=None, policy=None):
         self.strokes = available_strokes()
         stroke_path(stroke)                          # unknown stroke: one-line error before anything opens
         if stroke not in self.strokes:
             self.strokes.append(stroke)              # a stroke file given by path
+        # A learned residual (rl.policy.Policy) drives its own stroke on its own reference controller.
+        self.policy = policy
+        if policy is not None:
+            if stroke != policy.env["stroke"]:
+                raise ConfigError(f"the policy was trained for {policy.env['stroke']}; use --stroke {policy.env['stroke']}")
+            self.strokes = [stroke]
         self.currents, self.current_index = _presets(CURRENT_PRESETS_M_S, tuple(current_m_s), "custom current")
         density = DENSITY_PRESETS_KG_M3[0][1] if density_kg_m3 is None else float(density_kg_m3)
         self.densities, self.density_index = _presets(DENSITY_PRESETS_KG_M3, density, f"{density:g} kg/m3")
@@ -106,16 +113,11 @@ class SwimSession:
     def _build(self, stroke: str, position_xy_m, heading_rad: float, use_start_speed: bool) -> None:
         old = getattr(self, "episode", None)
         task = FollowTarget(self.target, position_xy_m, None if use_start_speed else 0.0, heading_rad)
-        try:
-            self.cycle_available = True
-            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=Layers(),
-                              backend=self.backend, fluid_settings=self.fluid_settings)
-        except CalibrationError as err:
-            # A stroke without a usable table still swims, with the rules but no steering.
-            self.cycle_available = False
-            self.message = f"per-cycle steering off: {err}"
-            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=Layers(cycle=False),
-                              backend=self.backend, fluid_settings=self.fluid_settings)
+        self._driver = None
+        if self.policy is not None:
+            episode = self._policy_episode(stroke, task)
+        else:
+            episode = self._episode(stroke, task)
         if old is not None:
             old.close()
         self.episode, self.sim, self.stroke = episode, episode.sim, stroke
@@ -131,8 +133,34 @@ class SwimSession:
         self.falling_behind = False
         self._record_trail()
 
+    def _policy_episode(self, stroke: str, task) -> Episode:
+        from layered_swim.control.residual import ResidualController
+        from layered_swim.rl.env import REFERENCES
+        from layered_swim.rl.policy import ResidualDriver
+
+        self.cycle_available = True
+        episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz,
+                          layers=Layers.parse(REFERENCES[self.policy.env["reference"]]), backend=self.backend,
+                          fluid_settings=self.fluid_settings, wrap=ResidualController)
+        self._driver = ResidualDriver(self.policy, episode)
+        return episode
+
+    def _episode(self, stroke: str, task) -> Episode:
+        try:
+            self.cycle_available = True
+            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=Layers(),
+                              backend=self.backend, fluid_settings=self.fluid_settings)
+        except CalibrationError as err:
+            # A stroke without a usable table still swims, with the rules but no steering.
+            self.cycle_available = False
+            self.message = f"per-cycle steering off: {err}"
+            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=Layers(cycle=False),
+                              backend=self.backend, fluid_settings=self.fluid_settings)
+        return episode
+
     def _apply_layers(self) -> None:
-        self.sim.controller.layers = self.layers if self.cycle_available else replace(self.layers, cycle=False)
+        if self.policy is None:       # a policy's reference keeps the layers it was trained on
+            self.sim.controller.layers = self.layers if self.cycle_available else replace(self.layers, cycle=False)
 
     # --- what the user does ------------------------------------------------------------
     def reset(self) -> None:
@@ -150,6 +178,9 @@ class SwimSession:
         self.set_stroke(self.strokes[(self.strokes.index(self.stroke) + step) % len(self.strokes)])
 
     def toggle_layer(self, name: str) -> None:
+        if self.policy is not None:
+            self.message = "the policy's reference controller keeps the layers it was trained with"
+            return
         self.layers = replace(self.layers, **{name: not getattr(self.layers, name)})
         self._apply_layers()
         if name == "cycle" and not self.cycle_available:
@@ -209,7 +240,7 @@ class SwimSession:
         if self.diverged:
             return
         try:
-            self.episode.run(steps=steps, observers=[self._after_step])
+            self.episode.run(steps=steps, observers=[self._driver, self._after_step] if self._driver else [self._after_step])
         except SimulationDiverged as err:
             self.diverged, self.divergence = True, str(err)
             self.message = f"{err}; press R to reset"

@@ -38,6 +38,53 @@ from layered_swim.tasks import swim_benchmark as bench
 REFERENCES = {"basic": "basic", "layered": "basic,cycle,rules"}
 
 
+class PolicyInput:
+    """The observation of an episode now, for any task: the environment gives it the goal
+    task's intermediate goals, a policy driving another task (``policy.ResidualDriver``) the
+    target's positions ahead. Keeps what the reward needs (``now``)."""
+
+    def __init__(self, episode, env_state: str):
+        sim = episode.sim
+        self.episode, self.env_state = episode, env_state
+        positions = sim.world.joint_positions()
+        _, rates = sim.world.joint_torques_and_rates()
+        self.layout = obs.layout_for(len(positions), len(rates), len(episode.body.segment_names), env_state)
+        self._links = [episode.body.index(name) for name in obs.TRACKED_LINKS]
+        self._smoothed = None
+        self.now = None
+
+    def reset(self) -> None:
+        self._smoothed = None
+
+    def __call__(self, force_n: np.ndarray, torque_nm: np.ndarray, goals_m: np.ndarray) -> np.ndarray:
+        """The vector from the episode's state, the water's mean wrenches since the last call and
+        the four intermediate goals (4, 3), world frame."""
+        sim, layout = self.episode.sim, self.layout
+        state = sim.state
+        att = attitude_of(state, self.episode.stroke.start.posture)
+        heading = att.heading_rad
+        root = state.pos_m[0]
+        goals, yaws = obs.local_goals(goals_m, root, heading)
+        env, self._smoothed = obs.env_features(self.env_state, force_n, torque_nm, state.pos_m, state.com_m, heading,
+                                               self._smoothed)
+        _, rates = sim.world.joint_torques_and_rates()
+        links = obs.to_heading_frame(np.concatenate([state.pos_m[self._links] - root,
+                                                     state.linvel_m_s[self._links] - state.linvel_m_s[0],
+                                                     state.linvel_m_s[:1], state.angvel_rad_s[:1]]), heading)
+        n = len(self._links)
+        parts = {
+            "root_height": root[2], "root_roll": att.roll_rad, "root_linvel": links[2 * n], "root_angvel": links[2 * n + 1],
+            "link_pos": links[:n].ravel(), "link_vel": links[n:2 * n].ravel(),
+            "joint_pos": sim.world.joint_positions(), "joint_vel": rates,
+            "phase": obs.phase_encoding(sim.controller.phase(sim.time_s)), "goals": goals.ravel(), "env": env,
+        }
+        vector = np.empty(layout.size, np.float32)
+        for name, where in layout.slices.items():
+            vector[where] = parts[name]
+        self.now = (state, att.roll_rad, yaws, rates.copy())
+        return vector
+
+
 class SwimGoalEnv(gym.Env):
     metadata = {"render_modes": []}
 
@@ -63,15 +110,12 @@ class SwimGoalEnv(gym.Env):
         self.dt_s = 1.0 / policy_hz
         self.stroke_name = stroke
         self.roll_tolerance_rad = math.radians(bench.ROLL_TOLERANCE_DEG.get(self.episode.stroke.name, 45.0))
-        positions = sim.world.joint_positions()
-        _, rates = sim.world.joint_torques_and_rates()
-        self.layout = obs.layout_for(len(positions), len(rates), len(self.episode.body.segment_names), env_state)
+        self.input = PolicyInput(self.episode, env_state)
+        self.layout = self.input.layout
         self.action_names = tuple(sim.layout.names)
         self.observation_space = gym.spaces.Box(-np.inf, np.inf, (self.layout.size,), np.float32)
         self.action_space = gym.spaces.Box(-1.0, 1.0, (len(self.action_names),), np.float32)
-        self._links = [self.episode.body.index(name) for name in obs.TRACKED_LINKS]
         self._body_point = {self.episode.body.index(name): w for name, w in BODY_POINT_WEIGHTS.items()}
-        self._smoothed = None
         self._last_obs = np.zeros(self.layout.size, np.float32)
         # Seconds spent stepping the physics and building observations and rewards, since
         # construction (``bench --env`` reads them; four clock reads a step cost nothing).
@@ -86,10 +130,10 @@ class SwimGoalEnv(gym.Env):
             goal = int(self.np_random.integers(len(self.episode.task.goals)))
         start_seed = options.get("start_seed", int(self.np_random.integers(1, 2**31)) if self.start_jitter else 0)
         self.episode.reset(seed=start_seed, goal=goal)      # seed 0: exactly SWIM's start; others jitter it
-        self._smoothed = None
+        self.input.reset()
         sim = self.episode.sim
         self._last_obs = self._observe(sim.fluid_now.force_n, sim.fluid_now.torque_nm)
-        self._rates = self._now[3]
+        self._rates = self.input.now[3]
         return self._last_obs.copy(), {"goal": goal, "goal_m": list(self.episode.task.goal.goal_m)}
 
     def step(self, action):
@@ -112,7 +156,7 @@ class SwimGoalEnv(gym.Env):
         torque /= self.physics_per_action
         self._last_obs = observation = self._observe(force, torque)
         rewarded = time.perf_counter()
-        rates = self._now[3]
+        rates = self.input.now[3]
         parts = self._reward((rates - self._rates) / self.dt_s)
         self._rates = rates
         done = time.perf_counter()
@@ -133,35 +177,11 @@ class SwimGoalEnv(gym.Env):
 
     # -- parts --------------------------------------------------------------------------
     def _observe(self, force_n: np.ndarray, torque_nm: np.ndarray) -> np.ndarray:
-        """The observation now; keeps what the reward needs of it (``self._now``)."""
-        sim, layout = self.episode.sim, self.layout
-        state = sim.state
-        att = attitude_of(state, self.episode.stroke.start.posture)
-        heading = att.heading_rad
-        root = state.pos_m[0]
-        goals_m = bench.intermediate_goals(self.episode.task.goal, sim.time_s, self.episode.stroke.period_s)
-        goals, yaws = obs.local_goals(goals_m, root, heading)
-        env, self._smoothed = obs.env_features(self.env_state, force_n, torque_nm, state.pos_m, state.com_m, heading,
-                                               self._smoothed)
-        _, rates = sim.world.joint_torques_and_rates()
-        links = obs.to_heading_frame(np.concatenate([state.pos_m[self._links] - root,
-                                                     state.linvel_m_s[self._links] - state.linvel_m_s[0],
-                                                     state.linvel_m_s[:1], state.angvel_rad_s[:1]]), heading)
-        n = len(self._links)
-        parts = {
-            "root_height": root[2], "root_roll": att.roll_rad, "root_linvel": links[2 * n], "root_angvel": links[2 * n + 1],
-            "link_pos": links[:n].ravel(), "link_vel": links[n:2 * n].ravel(),
-            "joint_pos": sim.world.joint_positions(), "joint_vel": rates,
-            "phase": obs.phase_encoding(sim.controller.phase(sim.time_s)), "goals": goals.ravel(), "env": env,
-        }
-        vector = np.empty(layout.size, np.float32)
-        for name, where in layout.slices.items():
-            vector[where] = parts[name]
-        self._now = (state, att.roll_rad, yaws, rates.copy())
-        return vector
+        goals = bench.intermediate_goals(self.episode.task.goal, self.episode.sim.time_s, self.episode.stroke.period_s)
+        return self.input(force_n, torque_nm, goals)
 
     def _reward(self, joint_accel: np.ndarray) -> dict:
-        state, roll, yaws, _ = self._now
+        state, roll, yaws, _ = self.input.now
         task = self.episode.task.goal
         body_point = sum(w * state.pos_m[k] for k, w in self._body_point.items())
         return reward_parts(bench.goal_position(task, state.time_s), state.pos_m[0], body_point, task.start_m,

@@ -1,6 +1,7 @@
 """A trained residual policy as a file: the actor, its observation normaliser and the
-environment it was trained in (``policy.pt``, small, loadable without the trainer's state), and
-running it on SWIM's goal task."""
+environment it was trained in (``policy.pt``, small, loadable without the trainer's state);
+running it on SWIM's goal task (``evaluate_goals``) and inside any other episode
+(``ResidualDriver``: trajectories, the app's mouse point)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -71,3 +72,46 @@ def evaluate_goals(policy: Policy, seeds: int = 5, goals: list[int] | None = Non
     complete = [r for r in runs if all(k in r for k in GOAL_METRICS)]
     mean = {k: float(np.mean([r[k] for r in complete])) if complete else None for k in GOAL_METRICS}
     return {**mean, "runs": runs, "terminated": sum(r["termination"] is not None for r in runs)}
+
+
+GOAL_LEADS_S = (0.1, 0.2)       # SWIM eq. 2's short-term goals; the medium-term ones are T/2 and T ahead
+
+
+class ResidualDriver:
+    """Drives ``episode`` (built with ``wrap=ResidualController`` around the policy's reference)
+    with ``policy``: an observer called after every physics step that, every 1/policy_hz, reads
+    the episode's state, the water's mean wrenches since its last action and four goals on the
+    task's target ahead (SWIM eq. 2's leads along the target's own path), and sets the residual."""
+
+    def __init__(self, policy: Policy, episode):
+        from layered_swim.rl.env import PolicyInput
+
+        self.policy, self.episode = policy, episode
+        self.actor = ActorSnapshot(policy.model)
+        self.input = PolicyInput(episode, policy.env["env_state"])
+        if self.input.layout.size != policy.model_args[0]:
+            raise ConfigError(f"the policy expects {policy.model_args[0]} observations, this episode gives "
+                              f"{self.input.layout.size}")
+        sim = episode.sim
+        self.every = sim.config.physics_hz // int(policy.env["policy_hz"])
+        self.scale = float(policy.env["action_scale_rad"])
+        self.leads_s = np.array([*GOAL_LEADS_S, episode.stroke.period_s / 2, episode.stroke.period_s])
+        self._force = np.zeros_like(sim.fluid_now.force_n)
+        self._torque = np.zeros_like(sim.fluid_now.torque_nm)
+        self.input.reset()
+        self._act(1)
+
+    def _act(self, steps: int) -> None:
+        sim, target = self.episode.sim, self.episode.task.target
+        goals = np.array([target.position(sim.time_s + lead) for lead in self.leads_s])
+        observation = self.input(self._force / steps, self._torque / steps, goals)
+        action, _ = self.actor.act(self.policy.normaliser(observation), True)
+        sim.controller.set_residual(self.scale * np.clip(action, -1.0, 1.0))
+        self._force[:] = 0.0
+        self._torque[:] = 0.0
+
+    def __call__(self, sim) -> None:
+        self._force += sim.fluid_now.force_n
+        self._torque += sim.fluid_now.torque_nm
+        if sim.steps % self.every == 0:
+            self._act(self.every)
