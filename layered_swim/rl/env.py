@@ -108,7 +108,6 @@ class SwimGoalEnv(gym.Env):
             raise ConfigError(f"policy_hz must divide the control rate {sim.config.control_hz} Hz, got {policy_hz!r}")
         self.physics_per_action = sim.config.physics_hz // policy_hz
         self.dt_s = 1.0 / policy_hz
-        self.stroke_name = stroke
         self.roll_tolerance_rad = math.radians(bench.ROLL_TOLERANCE_DEG.get(self.episode.stroke.name, 45.0))
         self.input = PolicyInput(self.episode, env_state)
         self.layout = self.input.layout

@@ -13,6 +13,7 @@ from layered_swim.config import ConfigError
 from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, Normaliser
 from layered_swim.rl.reward import RewardWeights
 from layered_swim.tasks.goal import GOAL_METRICS
+from layered_swim.tasks.swim_benchmark import goal_leads_s
 
 POLICY_FORMAT = 1
 
@@ -74,9 +75,6 @@ def evaluate_goals(policy: Policy, seeds: int = 5, goals: list[int] | None = Non
     return {**mean, "runs": runs, "terminated": sum(r["termination"] is not None for r in runs)}
 
 
-GOAL_LEADS_S = (0.1, 0.2)       # SWIM eq. 2's short-term goals; the medium-term ones are T/2 and T ahead
-
-
 class ResidualDriver:
     """Drives ``episode`` (built with ``wrap=ResidualController`` around the policy's reference)
     with ``policy``: an observer called after every physics step that, every 1/policy_hz, reads
@@ -95,7 +93,7 @@ class ResidualDriver:
         sim = episode.sim
         self.every = sim.config.physics_hz // int(policy.env["policy_hz"])
         self.scale = float(policy.env["action_scale_rad"])
-        self.leads_s = np.array([*GOAL_LEADS_S, episode.stroke.period_s / 2, episode.stroke.period_s])
+        self.leads_s = goal_leads_s(episode.stroke.period_s)
         self._force = np.zeros_like(sim.fluid_now.force_n)
         self._torque = np.zeros_like(sim.fluid_now.torque_nm)
         self.input.reset()

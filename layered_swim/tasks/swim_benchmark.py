@@ -101,9 +101,14 @@ def intermediate_goal(task: GoalTask, t_s, dt_s) -> np.ndarray:
     return goal_position(task, np.asarray(t_s, dtype=float) + dt_s)
 
 
+def goal_leads_s(cycle_s: float) -> np.ndarray:
+    """SWIM eq. 2's leads of the four intermediate goals: 0.1 s, 0.2 s, T_cycle/2, T_cycle."""
+    return np.array([0.1, 0.2, cycle_s / 2, cycle_s])
+
+
 def intermediate_goals(task: GoalTask, t_s: float, cycle_s: float) -> np.ndarray:
-    """SWIM eqs. 2-3: the four goals at dt = 0.1 s, 0.2 s, T_cycle/2, T_cycle. Shape (4, 3)."""
-    return intermediate_goal(task, t_s, np.array([0.1, 0.2, cycle_s / 2, cycle_s]))
+    """SWIM eqs. 2-3: the four goals ``goal_leads_s`` ahead on the schedule. Shape (4, 3)."""
+    return intermediate_goal(task, t_s, goal_leads_s(cycle_s))
 
 
 # --- metrics: each a mean over the logged samples ("computed at every time step and averaged
