@@ -74,7 +74,7 @@ def test_the_numpy_actor_matches_the_torch_distribution():
     action, log_prob = snapshot.act(obs, False, np.random.default_rng(4))
     dist = model.distribution(torch.as_tensor(obs)[None])
     assert snapshot.act(obs, True)[0] == pytest.approx(dist.mean[0].detach().numpy(), abs=1e-6)
-    assert log_prob == pytest.approx(float(dist.log_prob(torch.as_tensor(action)[None]).sum()), abs=1e-4)
+    assert log_prob == pytest.approx(float(dist.log_prob(torch.as_tensor(action)[None]).sum().detach()), abs=1e-4)
 
 
 def test_normaliser_merges_batches_exactly():
