@@ -46,10 +46,12 @@ class Policy:
 
     def env_kwargs(self, **changes) -> dict:
         """The training environment's arguments, with ``changes`` (backend, pool, current...)."""
-        env = {k: v for k, v in self.env.items()}
-        env["reward_weights"] = RewardWeights(**self.reward)
-        env.update(changes)
-        return env
+        return env_arguments(self.env, self.reward, **changes)
+
+
+def env_arguments(env: dict, reward: dict, **changes) -> dict:
+    """``SwimGoalEnv``'s keyword arguments from a config's ``env`` and ``reward`` sections."""
+    return {**env, "reward_weights": RewardWeights(**reward), **changes}
 
 
 def evaluate_goals(policy: Policy, seeds: int = 5, goals: list[int] | None = None, **env_changes) -> dict:

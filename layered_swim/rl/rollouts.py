@@ -51,11 +51,16 @@ def play(env, actor: ActorSnapshot, normaliser: Normaliser, seeds: list[int], de
 _ENV = None
 
 
-def _worker_init(env_kwargs: dict) -> None:
+def _set_env(env_kwargs: dict) -> None:
     global _ENV
+    _ENV = make_env(env_kwargs)
+
+
+def _worker_init(env_kwargs: dict) -> None:
+    """A worker process's start (never the trainer's own process: it would die with its shell)."""
     _die_with_parent()
     torch.set_num_threads(1)          # one core each: the workers are the parallelism
-    _ENV = make_env(env_kwargs)
+    _set_env(env_kwargs)
 
 
 def _die_with_parent() -> None:
@@ -77,8 +82,9 @@ def _chunk(model_args: tuple, model_state: dict, normaliser_state: dict, seeds: 
 
 
 class Rollouts:
-    """``collect(model, normaliser, n_episodes, seed)`` spread over ``workers``; ``ray_address``
-    sends the chunks to a Ray cluster instead ("local" starts one on this machine)."""
+    """``collect(model, model_args, normaliser, seeds)``: one episode per seed, spread over
+    ``workers`` (every ``workers``-th seed to each); ``ray_address`` sends the chunks to a Ray
+    cluster instead ("local" starts one on this machine)."""
 
     def __init__(self, env_kwargs: dict, workers: int, ray_address: str | None = None):
         self.workers, self._pool, self._ray = workers, None, None
@@ -97,7 +103,7 @@ class Rollouts:
             self._pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_worker_init,
                                              initargs=(env_kwargs,))
         else:
-            _worker_init(env_kwargs)
+            _set_env(env_kwargs)
 
     def collect(self, model: ActorCritic, model_args: tuple, normaliser: Normaliser,
                 seeds: list[int]) -> list[EpisodeData]:
@@ -113,10 +119,10 @@ class Rollouts:
             results = list(self._pool.map(_chunk, *zip(*args)))
         else:
             results = [_chunk(*a) for a in args]
-        by_seed = {}
-        for chunk, episodes in zip((a[-1] for a in args), results):
-            by_seed.update(zip(chunk, episodes))
-        return [by_seed[seed] for seed in seeds]
+        ordered: list = [None] * len(seeds)
+        for k, episodes in enumerate(results):     # chunk k holds seeds k, k + workers, ...
+            ordered[k::self.workers] = episodes
+        return ordered
 
     def close(self) -> None:
         if self._pool is not None:

@@ -22,10 +22,9 @@ from layered_swim.config import ConfigError
 from layered_swim.outputs import COMMAND_KEY, atomic_path, write_json, write_text
 from layered_swim.rl.buffer import EpisodeBuffer, EpisodeData, EvictionSettings
 from layered_swim.rl.config import TrainSpec
-from layered_swim.rl.policy import Policy, evaluate_goals
+from layered_swim.rl.policy import Policy, env_arguments, evaluate_goals
 from layered_swim.rl.ppo import ActorCritic, Normaliser, PpoSettings, update
 from layered_swim.rl.rollouts import Rollouts, make_env
-from layered_swim.rl.reward import RewardWeights
 
 CHECKPOINT, POLICY, LOG = "checkpoint.pt", "policy.pt", "progress.csv"
 LOG_FIELDS = ("epoch", "samples", "wall_s", "samples_per_s", "mean_return", "mean_steps", "terminated",
@@ -34,7 +33,7 @@ LOG_FIELDS = ("epoch", "samples", "wall_s", "samples_per_s", "mean_return", "mea
 
 
 def env_kwargs(spec: TrainSpec) -> dict:
-    return {**spec.env.model_dump(), "reward_weights": RewardWeights(**spec.reward.model_dump())}
+    return env_arguments(spec.env.model_dump(), spec.reward.model_dump())
 
 
 class Trainer:
@@ -69,7 +68,6 @@ class Trainer:
                  "optimiser": self.optimiser.state_dict(), "normaliser": self.normaliser.state_dict(),
                  "epoch": self.epoch, "samples": self.samples, "wall_s": self.wall_s,
                  "rng": self.rng.bit_generator.state, "generator": self.generator.get_state(),
-                 "torch_rng": torch.get_rng_state(),
                  "buffer": [_episode_state(e) for e in self.buffer.episodes]}
         for name, data in ((CHECKPOINT, state), (POLICY, self.policy().to_file())):
             with atomic_path(self.out / name) as tmp:
@@ -92,7 +90,6 @@ class Trainer:
         self.epoch, self.samples, self.wall_s = state["epoch"], state["samples"], state["wall_s"]
         self.rng.bit_generator.state = state["rng"]
         self.generator.set_state(state["generator"])
-        torch.set_rng_state(state["torch_rng"])
         self.buffer.episodes = [EpisodeData(**e) for e in state["buffer"]]
         _truncate_log(self.out / LOG, self.epoch)
 
