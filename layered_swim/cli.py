@@ -282,11 +282,25 @@ def _cmd_strokes(args) -> None:
         try:
             stroke = load_stroke(name, layout)
         except ConfigError as err:   # one broken file should not hide the others
-            rows.append([name, "-", f"invalid: {err}"])
+            rows.append([name, "-", "-", f"invalid: {err}"])
             continue
         first_line = (stroke.description.strip().splitlines() or [""])[0]
-        rows.append([name, f"{60.0 / stroke.period_s:.1f}", first_line])
-    print(_table(rows, ["stroke", "cycles/min", "description"]))
+        rows.append([name, f"{60.0 / stroke.period_s:.1f}", _speed_range(stroke), first_line])
+    print(_table(rows, ["stroke", "cycles/min", "speed m/s", "description"]))
+
+
+def _speed_range(stroke) -> str:
+    """The calibrated steady speed from the stroke's slowest working tempo (its ``min_tempo``) to
+    the fastest tempo measured; '-' without a table."""
+    from layered_swim.control.calibration import CalibrationError, load_table
+
+    try:
+        pace = load_table(stroke).pace
+    except CalibrationError:
+        return "-"
+    slowest = stroke.steering.min_tempo
+    speeds = [pace.speed_at(slowest)] + [v for t, v in zip(pace.tempos, pace.speed_m_s) if t > slowest]
+    return f"{min(speeds):.2f}-{max(speeds):.2f}"
 
 
 def _cmd_validate(args) -> None:
@@ -418,7 +432,9 @@ def _cmd_calibrate(args) -> None:
     rows = [[name, f"{table.tempos[-1]:g}"] + [f"{math.degrees(v):.1f}" for v in turns[-1]]
             for name, turns in table.turn_rad.items()]
     print(_table(rows, ["sequence", "tempo"] + [f"w={w:g}" for w in table.weights]))
-    print(f"\nturn in degrees per cycle; speed at tempo {table.tempos[-1]:g}: {table.speed_m_s[-1]:.2f} m/s; wrote {path}")
+    pace = table.pace
+    print(f"\nturn in degrees per cycle; speed {min(pace.speed_m_s):.2f}-{max(pace.speed_m_s):.2f} m/s at tempo "
+          f"{pace.tempos[0]:g}-{pace.tempos[-1]:g}; wrote {path}")
 
 
 def _cmd_follow(args) -> None:

@@ -34,6 +34,10 @@ def test_strokes_lists_rest():
     assert result.returncode == 0, result.stderr
     rest = [line for line in result.stdout.splitlines() if line.startswith("rest ")]
     assert rest and "15.0" in rest[0] and "float" in rest[0]
+    # Each calibrated stroke's speed range, from its slowest working tempo to the fastest measured.
+    crawl = [line for line in result.stdout.splitlines() if line.startswith("front_crawl ")][0]
+    low, high = (float(v) for v in crawl.split()[2].split("-"))
+    assert 1.0 < low < high < 2.0
 
 
 def test_run_json(tmp_path):

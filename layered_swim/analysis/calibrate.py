@@ -3,7 +3,8 @@
 For every perturbation sequence of a stroke, simulate the swimmer in still water at a grid of
 weights and tempos (tempo sets the swimming speed): a few basic cycles to settle, then a few
 cycles with the sequence at that weight. The change of the cycle-averaged heading (yaw), body
-pitch or shoulder roll per cycle, minus the unperturbed drift, is the sequence's turn
+pitch or shoulder roll per cycle, minus the unperturbed drift, is the sequence's turn. The
+unperturbed swims, at more tempos, give the stroke's pace: speed, roll, pitch and depth
 (``layered_swim/control/calibration.py`` keeps and reads the table).
 """
 from __future__ import annotations
@@ -13,7 +14,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from layered_swim.config import ConfigError
-from layered_swim.control.calibration import SEQUENCE_AXIS, CalibrationTable
+from layered_swim.control.calibration import SEQUENCE_AXIS, CalibrationTable, Pace
 from layered_swim.control.layered import Layers, fixed_weights
 from layered_swim.control.steering import attitude_of, wrap_angle
 from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
@@ -22,6 +23,7 @@ from layered_swim.episode import Episode
 AXIS_INDEX = {"yaw": 0, "pitch": 1, "roll": 2}       # columns of a swim's (yaw, pitch, roll) change
 WEIGHTS = (0.0, 0.25, 0.5, 0.75, 1.0)
 TEMPOS = (0.7, 1.0)
+PACE_TEMPOS = (0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2)     # includes TEMPOS: their drift is measured once
 SETTLE_CYCLES = 3
 MEASURE_CYCLES = 2
 
@@ -51,7 +53,8 @@ class _CycleAttitude:
 
 def _measure(job: tuple[str, str | None, float, float]) -> tuple:
     """One calibration swim: (angle change per cycle about the sequence's axis, mean speed, the
-    last cycle's mean roll); with no sequence the change is (yaw, pitch, roll)."""
+    last cycle's mean roll and pitch, the final depth of the centre of mass); with no sequence
+    the change is (yaw, pitch, roll)."""
     stroke_name, sequence, weight, tempo = job
     weights = {sequence: weight} if sequence else {}
     episode = Episode(stroke_name, weights=fixed_weights(weights, SETTLE_CYCLES, tempo),
@@ -69,15 +72,20 @@ def _measure(job: tuple[str, str | None, float, float]) -> tuple:
     change = (after - before) / MEASURE_CYCLES
     track = np.array(attitude.positions)
     speed = float(np.linalg.norm(track[-1, :2] - track[0, :2]) / (len(track) / control_hz))
-    return (float(change[axis]) if sequence else change.tolist()), speed, float(-after[2])   # roll: left up > 0
+    return ((float(change[axis]) if sequence else change.tolist()), speed, float(-after[2]),   # roll: left up > 0
+            float(after[1]), float(-track[-1, 2]))
 
 
-def calibrate(stroke: Stroke, weights=WEIGHTS, tempos=TEMPOS, workers: int = 2, progress: bool = False) -> CalibrationTable:
-    """Simulate every sequence at every weight and tempo (in parallel) and build the table."""
+def calibrate(stroke: Stroke, weights=WEIGHTS, tempos=TEMPOS, pace_tempos=PACE_TEMPOS, workers: int = 2,
+              progress: bool = False) -> CalibrationTable:
+    """Simulate every sequence at every weight and tempo, and the unperturbed stroke at every
+    pace tempo (in parallel), and build the table."""
     sequences = [name for name in SEQUENCE_NAMES if name in stroke.perturbations]
     if not sequences:
         raise ConfigError(f"{stroke.source}: the stroke has no perturbation sequences to calibrate")
-    jobs = [(stroke.source, None, 0.0, tempo) for tempo in tempos]
+    if not set(tempos) <= set(pace_tempos):
+        raise ValueError("every turn tempo must be a pace tempo (its unperturbed drift comes from there)")
+    jobs = [(stroke.source, None, 0.0, tempo) for tempo in pace_tempos]
     jobs += [(stroke.source, seq, w, tempo) for seq in sequences for tempo in tempos for w in weights if w > 0]
     with ProcessPoolExecutor(max_workers=workers) as pool:
         results = pool.map(_measure, jobs)
@@ -85,10 +93,10 @@ def calibrate(stroke: Stroke, weights=WEIGHTS, tempos=TEMPOS, workers: int = 2, 
             from tqdm import tqdm
             results = tqdm(results, total=len(jobs), desc=f"calibrating {stroke.name}", unit="swim")
         results = list(results)
-    baseline = {tempo: results[i][0] for i, tempo in enumerate(tempos)}      # drift with no perturbation
-    speeds = tuple(results[i][1] for i in range(len(tempos)))
-    rolls = tuple(results[i][2] for i in range(len(tempos)))
-    measured = iter(results[len(tempos):])
+    unperturbed = results[:len(pace_tempos)]
+    baseline = {tempo: unperturbed[pace_tempos.index(tempo)][0] for tempo in tempos}   # drift with no perturbation
+    pace = Pace(tuple(pace_tempos), *(tuple(r[k] for r in unperturbed) for k in (1, 2, 3, 4)))
+    measured = iter(results[len(pace_tempos):])
     turn_rad = {}
     for seq in sequences:
         axis, sign = SEQUENCE_AXIS[seq]
@@ -97,5 +105,4 @@ def calibrate(stroke: Stroke, weights=WEIGHTS, tempos=TEMPOS, workers: int = 2, 
         for tempo in tempos:
             rows.append([0.0] + [sign * (next(measured)[0] - baseline[tempo][k]) for w in weights if w > 0])
         turn_rad[seq] = np.array(rows)
-    return CalibrationTable(stroke.name, stroke.spec_sha256, tuple(weights), tuple(tempos), speeds, rolls,
-                            turn_rad)
+    return CalibrationTable(stroke.name, stroke.spec_sha256, tuple(weights), tuple(tempos), pace, turn_rad)

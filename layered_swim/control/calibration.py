@@ -1,6 +1,7 @@
 """The per-cycle layer's calibration table (Yang 4.3): each perturbation sequence's turn per cycle
 at a grid of weights and tempos, read from ``strokes/calibration/<stroke>.yaml`` and inverted
-to pick the weight that turns the swimmer through the wanted angle. ``layered-swim calibrate``
+to pick the weight that turns the swimmer through the wanted angle; and the stroke's pace, its
+steady speed, roll, pitch and depth over a wider range of tempos. ``layered-swim calibrate``
 measures it (``layered_swim/analysis/calibrate.py``). A table made from a different version of
 the stroke file is stale: loading it is an error that says how to remake it.
 """
@@ -33,6 +34,26 @@ def _increasing(values: list[float], field: str) -> None:
         raise ValueError(f"{field} must increase")
 
 
+class PaceSpec(Strict):
+    """The unperturbed stroke swum straight at each tempo: its steady speed, its own cycle-mean
+    shoulder roll and body pitch (what steering counts as level), and the depth its centre of
+    mass ends at."""
+
+    tempos: list[between(0.05, 5.0)] = Field(min_length=1)
+    speed_m_s: list[between(-5.0, 5.0)]
+    roll_deg: list[between(-90.0, 90.0)]
+    pitch_deg: list[between(-90.0, 90.0)]
+    depth_m: list[between(-5.0, 50.0)]
+
+    @model_validator(mode="after")
+    def _shapes(self) -> "PaceSpec":
+        _increasing(self.tempos, "pace.tempos")
+        n = len(self.tempos)
+        if any(len(values) != n for values in (self.speed_m_s, self.roll_deg, self.pitch_deg, self.depth_m)):
+            raise ValueError(f"pace: speed_m_s, roll_deg, pitch_deg and depth_m need one value per tempo ({n})")
+        return self
+
+
 class CalibrationSpec(Strict):
     """The file as ``save_table`` writes it."""
 
@@ -40,8 +61,7 @@ class CalibrationSpec(Strict):
     stroke_sha256: str
     weights: list[between(0.0, 10.0)] = Field(min_length=2)
     tempos: list[between(0.05, 5.0)] = Field(min_length=1)
-    speed_m_s: list[between(-5.0, 5.0)]
-    roll_deg: list[between(-90.0, 90.0)]
+    pace: PaceSpec
     turn_deg_per_cycle: dict[Sequence, list[list[Degrees]]]
 
     @model_validator(mode="after")
@@ -49,12 +69,28 @@ class CalibrationSpec(Strict):
         _increasing(self.weights, "weights")
         _increasing(self.tempos, "tempos")
         n = len(self.tempos)
-        if len(self.speed_m_s) != n or len(self.roll_deg) != n:
-            raise ValueError(f"speed_m_s and roll_deg need one value per tempo ({n})")
         for name, rows in self.turn_deg_per_cycle.items():
             if len(rows) != n or any(len(row) != len(self.weights) for row in rows):
                 raise ValueError(f"turn_deg_per_cycle.{name} needs {n} rows of {len(self.weights)} numbers")
         return self
+
+
+@dataclass(frozen=True)
+class Pace:
+    """The unperturbed stroke at each of ``tempos`` (increasing): steady speed, cycle-mean shoulder
+    roll (left up > 0) and body pitch (nose up > 0), and the depth of its centre of mass at the end."""
+
+    tempos: tuple[float, ...]
+    speed_m_s: tuple[float, ...]
+    roll_rad: tuple[float, ...]
+    pitch_rad: tuple[float, ...]
+    depth_m: tuple[float, ...]
+
+    def roll_at(self, tempo: float) -> float:
+        return float(np.interp(tempo, self.tempos, self.roll_rad))
+
+    def speed_at(self, tempo: float) -> float:
+        return float(np.interp(tempo, self.tempos, self.speed_m_s))
 
 
 @dataclass(frozen=True)
@@ -63,13 +99,12 @@ class CalibrationTable:
     stroke_sha256: str
     weights: tuple[float, ...]
     tempos: tuple[float, ...]
-    speed_m_s: tuple[float, ...]               # steady speed at each tempo
-    roll_rad: tuple[float, ...]                # the stroke's own cycle-mean shoulder roll (left up > 0)
+    pace: Pace
     turn_rad: dict[str, np.ndarray]            # per sequence (n_tempos, n_weights), in its own direction
 
     def roll_at(self, tempo: float) -> float:
         """The unperturbed stroke's mean roll: the level the per-cycle layer steers back to."""
-        return float(np.interp(tempo, self.tempos, self.roll_rad))
+        return self.pace.roll_at(tempo)
 
     def turn_at(self, sequence: str, tempo: float) -> np.ndarray:
         rows = self.turn_rad[sequence]
@@ -109,8 +144,10 @@ def save_table(table: CalibrationTable, path: Path) -> Path:
         "stroke_sha256": table.stroke_sha256,
         "weights": list(table.weights),
         "tempos": list(table.tempos),
-        "speed_m_s": [round(s, 4) for s in table.speed_m_s],
-        "roll_deg": [round(math.degrees(a), 3) for a in table.roll_rad],
+        "pace": {"tempos": list(table.pace.tempos), "speed_m_s": [round(s, 4) for s in table.pace.speed_m_s],
+                 "roll_deg": [round(math.degrees(a), 3) for a in table.pace.roll_rad],
+                 "pitch_deg": [round(math.degrees(a), 3) for a in table.pace.pitch_rad],
+                 "depth_m": [round(d, 3) for d in table.pace.depth_m]},
         "turn_deg_per_cycle": {name: [[round(math.degrees(v), 3) for v in row] for row in rows]
                                for name, rows in table.turn_rad.items()},
     }
@@ -133,5 +170,6 @@ def load_table(stroke: Stroke, directory: Path = CALIBRATION_DIR) -> Calibration
         raise CalibrationError(f"{path}: stale calibration table (stroke file {stroke.source} changed since); {remake}")
     return CalibrationTable(
         stroke=spec.stroke, stroke_sha256=spec.stroke_sha256, weights=tuple(spec.weights), tempos=tuple(spec.tempos),
-        speed_m_s=tuple(spec.speed_m_s), roll_rad=tuple(math.radians(a) for a in spec.roll_deg),
+        pace=Pace(tuple(spec.pace.tempos), tuple(spec.pace.speed_m_s), tuple(math.radians(a) for a in spec.pace.roll_deg),
+                  tuple(math.radians(a) for a in spec.pace.pitch_deg), tuple(spec.pace.depth_m)),
         turn_rad={name: np.radians(np.array(rows, dtype=float)) for name, rows in spec.turn_deg_per_cycle.items()})

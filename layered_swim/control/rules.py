@@ -8,7 +8,8 @@
 * Arm reach: reach further (extend the elbow) while the hand's drag helps, keep the arm closer
   (flex the elbow) while it hinders.
 
-Pure functions of the body state, the water velocity at the hands and the desired direction.
+A stroke whose hands recover through the air keeps a rule to the helping phase (``hindering:
+false`` in its file). Pure functions of the body state, the water velocity at the hands and the desired direction.
 """
 from __future__ import annotations
 
@@ -72,7 +73,7 @@ def rule_offsets(previous: np.ndarray, arms: list[ArmIndices], rules: RulesSpec,
         flow_dir = flow / speed
         helpfulness = float(flow_dir @ desired_dir)   # > 0: the drag on the hand pushes where we want to go
         strength = min(speed, 1.0)
-        if palm:
+        if palm and (helpfulness > 0.0 or rules.palm.hindering):
             normal = quat_rotate(quat_xyzw[arm.hand], PALM_NORMAL_LOCAL)
             axes = quat_rotate(quat_xyzw[arm.forearm], arm.wrist_axes)
             turning = np.cross(axes, normal)                       # d(normal)/d(angle), one row per axis
@@ -83,7 +84,7 @@ def rule_offsets(previous: np.ndarray, arms: list[ArmIndices], rules: RulesSpec,
             gradient = 2.0 * abs(facing) * along * (turning @ flow_dir) + facing * abs(facing) * (turning @ desired_dir)
             pull[list(arm.palm_coords)] = rules.palm.gain * strength * gradient
             limit[list(arm.palm_coords)] = np.radians(rules.palm.max_deg)
-        if reach:
+        if reach and (helpfulness > 0.0 or rules.reach.hindering):
             pull[arm.elbow_coord] = -rules.reach.gain * helpfulness * strength
             limit[arm.elbow_coord] = np.radians(rules.reach.max_deg)
     faded = previous * (1.0 - dt_s / RULE_MEMORY_S)

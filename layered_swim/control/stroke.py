@@ -61,6 +61,10 @@ class RuleSpec(Strict):
     enabled: bool = True
     gain: float = Field(30.0, ge=0.0, le=200.0)   # rad/s of offset per unit of the rule's gradient
     max_deg: float = Field(35.0, gt=0.0, le=90.0)
+    # Also act while the water hinders (slice the palm, pull the arm in): for a recovery under
+    # water. A crawl's hand only hinders from entry to catch, where slicing turns the palm away
+    # just before the pull, so its rules act only while the water helps.
+    hindering: bool = True
 
 
 class RulesSpec(Strict):
@@ -244,8 +248,10 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
         if joint not in joints:
             raise ConfigError(f"{source}: field 'steering.glide_moving_joints': unknown joint '{joint}'")
     glide_moving = np.array([name.split(".")[0] in spec.steering.glide_moving_joints for name in layout.names])
-    # What calibration measures: the steering settings only read its table, so they stay out.
-    digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude={"steering"}), sort_keys=True).encode()).hexdigest()
+    # What calibration measures: it swims without the rules, and the steering settings only read
+    # its table, so both stay out.
+    digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude={"steering", "rules"}),
+                                       sort_keys=True).encode()).hexdigest()
     return Stroke(spec.name, spec.description, spec.period_s, spec.start, basic, perturbations, spec.rules,
                   spec.steering, glide_moving, dict(spec.pd_gain_scale), source, digest)
 
