@@ -87,6 +87,7 @@ class Pace:
     depth_m: tuple[float, ...]
 
     def roll_at(self, tempo: float) -> float:
+        """The unperturbed stroke's mean roll: the level the per-cycle layer steers back to."""
         return float(np.interp(tempo, self.tempos, self.roll_rad))
 
     def speed_at(self, tempo: float) -> float:
@@ -101,10 +102,6 @@ class CalibrationTable:
     tempos: tuple[float, ...]
     pace: Pace
     turn_rad: dict[str, np.ndarray]            # per sequence (n_tempos, n_weights), in its own direction
-
-    def roll_at(self, tempo: float) -> float:
-        """The unperturbed stroke's mean roll: the level the per-cycle layer steers back to."""
-        return self.pace.roll_at(tempo)
 
     def turn_at(self, sequence: str, tempo: float) -> np.ndarray:
         rows = self.turn_rad[sequence]

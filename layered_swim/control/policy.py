@@ -79,7 +79,8 @@ class TargetPolicy:
         distance = float(np.linalg.norm(self.target.position(state.time_s) - position))
         drive = self.tempo_control.drive(distance, heading_error)
         tempo = self.tempo_control.tempo_for(drive)
-        self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains, self.table.roll_at(tempo))
+        self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains,
+                                        self.table.pace.roll_at(tempo))
         glide = distance < self.tempo_control.glide_within_m and abs(heading_error) < self.tempo_control.easy_turn_rad
         # Near the target, or turning hard, the rules stop seeking more thrust (Yang 4.4: more force
         # only where more is wanted); else they speed the swimmer past a slow target.

@@ -9,7 +9,8 @@
   (flex the elbow) while it hinders.
 
 A stroke whose hands recover through the air keeps a rule to the helping phase (``hindering:
-false`` in its file). Pure functions of the body state, the water velocity at the hands and the desired direction.
+false`` in its file). Pure functions of the body state, the water velocity at the hands and the
+desired direction.
 """
 from __future__ import annotations
 
