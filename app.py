@@ -18,7 +18,8 @@ def parser() -> argparse.ArgumentParser:
     from layered_swim.cli import OneLineParser, steering_options   # argparse only: --help stays fast
 
     p = OneLineParser(prog=PROG, description="Swim after the mouse (or a trajectory) in a real-time 3-D window.")
-    p.add_argument("--stroke", default="breaststroke", help="stroke name or path to a stroke .yaml (default breaststroke)")
+    p.add_argument("--stroke", default="breaststroke",
+                   help="stroke name, path to a stroke .yaml, or auto (chooses and switches strokes; default breaststroke)")
     p.add_argument("--trajectory", help="a trajectory name or .yaml file: show its path and chase its target")
     p.add_argument("--backend", default="plate",
                    help="fluid model; the window runs only plate (SPH is ~20x slower than real time: use `layered-swim render --backend sph`)")

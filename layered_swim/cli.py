@@ -72,7 +72,8 @@ def _parser() -> argparse.ArgumentParser:
 
     follow = sub.add_parser("follow", help="chase a target moving along a trajectory file")
     follow.add_argument("trajectory", help="trajectory name (see trajectories/) or path to a .yaml")
-    follow.add_argument("--stroke", default="breaststroke")
+    follow.add_argument("--stroke", default="breaststroke", help="stroke name, path to a stroke .yaml, or auto "
+                                                                 "(chooses and switches strokes)")
     steering_options(follow)
     follow.add_argument("--seconds", type=float, default=60.0)
     follow.add_argument("--out", help="output folder (default runs/follow-<trajectory>-<timestamp>)")
@@ -80,6 +81,10 @@ def _parser() -> argparse.ArgumentParser:
     follow.add_argument("--json", action="store_true")
     follow.add_argument("--policy", metavar="FILE", help="a trained residual (policy.pt from `train`) on its reference "
                                                           "controller (--layers then comes from the policy)")
+    follow.add_argument("--seeds", type=int, metavar="N",
+                        help="swim N times from starts moved by up to 10 deg and 0.3 m, and report each headline "
+                             "number's median (and range) over them")
+    _parallel_options(follow)
     _backend_option(follow, pool="large")       # a trajectory's target starts 2 m ahead
 
     goal = sub.add_parser("goal", help="SWIM's goal-reaching benchmark (Pos, Prog, Dev, Roll)")
@@ -99,7 +104,8 @@ def _parser() -> argparse.ArgumentParser:
     render.add_argument("--seconds", type=float, help="length (default: the whole run, or 20 s of a trajectory)")
     render.add_argument("--fps", type=float, default=30.0)
     render.add_argument("--size", default="960x540", metavar="WxH")
-    render.add_argument("--stroke", default="breaststroke", help="stroke for a trajectory (default breaststroke)")
+    render.add_argument("--stroke", default="breaststroke", help="stroke for a trajectory (default breaststroke; "
+                                                                "auto chooses)")
     steering_options(render)
     render.add_argument("--forces", action="store_true", help="draw the per-segment fluid-force arrows")
     render.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -274,6 +280,7 @@ def _cmd_strokes(args) -> None:
     from layered_swim.body.model import load_body
     from layered_swim.config import ConfigError
     from layered_swim.body.layout import joint_layout
+    from layered_swim.control.auto import AUTO, AUTO_STROKES
     from layered_swim.control.stroke import available_strokes, load_stroke
 
     layout = joint_layout(load_body())
@@ -287,6 +294,7 @@ def _cmd_strokes(args) -> None:
         first_line = (stroke.description.strip().splitlines() or [""])[0]
         rows.append([name, f"{60.0 / stroke.period_s:.1f}", _speed_range(stroke), first_line])
     print(_table(rows, ["stroke", "cycles/min", "speed m/s", "description"]))
+    print(f"\n{AUTO}: chases a target with {', '.join(AUTO_STROKES)}, switched between cycles (follow, goal, render, the app)")
 
 
 def _speed_range(stroke) -> str:
@@ -443,6 +451,9 @@ def _cmd_follow(args) -> None:
     from layered_swim.runs import default_out_dir, follow_run
 
     layers, steered = Layers.parse(args.layers), {}
+    if args.seeds is not None:
+        _follow_seeds(args, layers)
+        return
     if args.policy:        # the residual on its own reference controller, run by its driver
         from layered_swim.control.residual import ResidualController
         from layered_swim.rl.env import REFERENCES
@@ -464,6 +475,26 @@ def _cmd_follow(args) -> None:
     flat.update({f"swim.{k}": v for k, v in result.get("swim_metrics", {}).items() if v is not None})
     print(_table([[k, _fmt(v)] for k, v in flat.items()]))
     print(f"\nwrote summary.json, config.json, track.npz, log.npz to {out}")
+
+
+def _follow_seeds(args, layers) -> None:
+    from layered_swim.analysis.robustness import follow_seeds
+    from layered_swim.config import ConfigError
+    from layered_swim.runs import default_out_dir
+
+    if args.policy or args.backend != "plate":
+        raise ConfigError("--seeds runs the layered controller on the plate backend only (no --policy, --backend sph)")
+    out = str(_out_dir(args, default_out_dir(f"follow-{Path(args.trajectory).stem}-seeds")))
+    summary = follow_seeds(args.trajectory, args.stroke, layers, _vector(args.current, "--current"), args.density,
+                           args.seconds, args.seeds, out, max(1, args.workers), _progress(args))
+    if args.json:
+        print(json.dumps({**summary, "out_dir": out}, allow_nan=False))
+        return
+    rows = [[k, *(_fmt(v[q]) for q in ("median", "min", "max"))] for k, v in summary["median"].items()]
+    print(_table(rows, ["over " + str(args.seeds) + " starts", "median", "min", "max"]))
+    if "reached_all_share" in summary:
+        print(f"\nreached every station in {summary['reached_all_share']:.0%} of the runs")
+    print(f"\nwrote summary.json (every run) and config.json to {out}")
 
 
 def _cmd_goal(args) -> None:

@@ -7,12 +7,14 @@ After dm_control's Physics / Task / Environment split and Gymnasium's ``reset(se
 - ``reset(seed, **options)`` asks the task where to start (it may move its target: a goal task
   takes ``goal=k``), resets the simulation there without rebuilding anything, and lets the task
   take its first sample. Seed 0 starts exactly where the task says; any other seed jitters that
-  start (``jittered_start``), the same way every time for the same seed.
+  start (``jittered_start``, within ``jitter``), the same way every time for the same seed.
 - ``step()`` runs one physics step and lets the task observe it; ``run(seconds)`` is the loop
   every command, the calibration, the experiments, the app and the bench go through, with
   ``observers`` (a recorder, a push, the app's trail) called after every step.
 
-Which controller drives the swimmer: ``weights`` (a scripted per-cycle policy) gives the
+``stroke="auto"`` builds a layered controller for each of ``AUTO_STROKES`` and lets
+``control/auto.py`` switch between them; the start is the first one's. Which controller drives
+the swimmer: ``weights`` (a scripted per-cycle policy) gives the
 layered controller with those weights; otherwise a task without a target gets the basic stroke
 alone, and a task with one gets the layered controller steering toward it (``layers`` says
 which layers are on; the per-cycle layer reads the stroke's calibration table). ``wrap`` puts
@@ -24,7 +26,7 @@ import contextlib
 import math
 import signal
 import threading
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Callable, Iterable
 
 import numpy as np
@@ -32,6 +34,7 @@ import numpy as np
 from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, load
+from layered_swim.control.auto import AUTO, AUTO_STROKES, AutoStrokeController
 from layered_swim.control.basic import StrokeController
 from layered_swim.control.calibration import load_table
 from layered_swim.control.layered import Layers, LayeredController, WeightPolicy, fixed_weights
@@ -49,23 +52,49 @@ from layered_swim.tasks import Task
 Observer = Callable[[Simulation], None]
 
 
+@dataclass(frozen=True)
+class StartJitter:
+    """How far a non-zero seed moves the start: uniform within +-these."""
+
+    heading_rad: float = math.radians(5.0)
+    position_m: float = 0.1
+    depth_m: float = 0.03
+    speed_share: float = 0.1
+
+
+START_JITTER = StartJitter()
+# The robustness runs (``follow --seeds``): a start a user might give, not a nudge.
+WIDE_JITTER = StartJitter(heading_rad=math.radians(10.0), position_m=0.3)
+
+
 class Episode:
     def __init__(self, stroke: str, task: Task | None = None, *, medium: Medium = Medium(), backend: str = "plate",
                  fluid_settings=None, lung_air_l: float | None = None, physics_hz: int = 480, tempo: float = 1.0,
                  layers: Layers = Layers(), weights: WeightPolicy | None = None,
-                 tempo_control: TempoControl | None = None, seed: int = 0,
+                 tempo_control: TempoControl | None = None, seed: int = 0, jitter: StartJitter = START_JITTER,
                  wrap: Callable[[object, JointLayout], object] | None = None):
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
             raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
         self.task = task if task is not None else Task()     # swim the stroke; nothing asked, nothing sampled
-        self.seed = seed
+        self.seed, self.jitter = seed, jitter
         self.body = load_body(lung_air_l=lung_air_l)
         layout = joint_layout(self.body)
-        path = stroke_path(stroke)
-        self.stroke_spec: StrokeSpec = load(StrokeSpec, path)     # the file as validated, for config.json
-        self.stroke: Stroke = build_stroke(self.stroke_spec, layout, str(path))
-        controller = _controller(self.stroke, self.body, layout, self.task.target, layers, weights, tempo,
-                                 tempo_control)
+        names = AUTO_STROKES if stroke == AUTO else (stroke,)
+        specs = {name: load(StrokeSpec, stroke_path(name)) for name in names}    # as validated, for config.json
+        strokes = {name: build_stroke(spec, layout, str(stroke_path(name))) for name, spec in specs.items()}
+        # The start and the config are the first stroke's (the one ``auto`` starts with).
+        self.stroke_spec: StrokeSpec = specs[names[0]]
+        self.stroke: Stroke = strokes[names[0]]
+        if stroke == AUTO:
+            if self.task.target is None or weights is not None or not layers.cycle:
+                raise ConfigError("--stroke auto chooses strokes to chase a target: it needs one (follow, goal, "
+                                  "the app) and the per-cycle layer")
+            controller = AutoStrokeController(
+                {name: _controller(s, self.body, layout, self.task.target, layers, None, tempo, tempo_control)
+                 for name, s in strokes.items()}, self.task.target)
+        else:
+            controller = _controller(self.stroke, self.body, layout, self.task.target, layers, weights, tempo,
+                                     tempo_control)
         if wrap is not None:          # e.g. a learned residual on top (control/residual.py)
             controller = wrap(controller, layout)
         config = SimConfig(physics_hz=physics_hz)
@@ -92,7 +121,7 @@ class Episode:
             self.seed, self.rng = seed, np.random.default_rng(seed)
         start = self.task.reset(self, self.rng, **options)
         if self.seed:
-            start = jittered_start(start, self.rng)
+            start = jittered_start(start, self.rng, self.jitter)
         self.sim.reset(start)
         self.task.observe(self.sim)
         return self.sim.state
@@ -160,18 +189,14 @@ def _ctrl_c_between_steps():
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
-START_JITTER = {"heading_rad": math.radians(5.0), "position_m": 0.1, "depth_m": 0.03, "speed_share": 0.1}
-
-
-def jittered_start(start: Start, rng: np.random.Generator) -> Start:
-    """``start`` moved by uniform random amounts within ``START_JITTER``: what a non-zero seed
-    does, so runs with different seeds differ and one seed repeats exactly."""
-    j = START_JITTER
+def jittered_start(start: Start, rng: np.random.Generator, jitter: StartJitter = START_JITTER) -> Start:
+    """``start`` moved by uniform random amounts within ``jitter``: what a non-zero seed does, so
+    runs with different seeds differ and one seed repeats exactly."""
     heading, speed, depth = rng.uniform(-1.0, 1.0, 3)
-    dx, dy = rng.uniform(-j["position_m"], j["position_m"], 2)
-    return replace(start, heading_rad=start.heading_rad + heading * j["heading_rad"],
-                   speed_m_s=start.speed_m_s * (1.0 + speed * j["speed_share"]),
-                   depth_m=max(0.0, start.depth_m + depth * j["depth_m"]),
+    dx, dy = rng.uniform(-jitter.position_m, jitter.position_m, 2)
+    return replace(start, heading_rad=start.heading_rad + heading * jitter.heading_rad,
+                   speed_m_s=start.speed_m_s * (1.0 + speed * jitter.speed_share),
+                   depth_m=max(0.0, start.depth_m + depth * jitter.depth_m),
                    position_xy_m=(start.position_xy_m[0] + dx, start.position_xy_m[1] + dy))
 
 

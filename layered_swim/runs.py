@@ -24,7 +24,7 @@ from layered_swim.control.layered import Layers
 from layered_swim.control.policy import TempoControl
 from layered_swim.control.stroke import available_strokes
 from layered_swim.control.targets import load_trajectory
-from layered_swim.episode import Episode
+from layered_swim.episode import START_JITTER, Episode, StartJitter
 from layered_swim.fluid.medium import Medium, preset
 from layered_swim.fluid.backend import FluidError
 from layered_swim.outputs import COMMAND_KEY, atomic_path, write_json
@@ -238,18 +238,20 @@ def _metrics(episode: Episode, stopped: BaseException | None) -> dict:
 
 def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = Layers(), current=(0.0, 0.0, 0.0),
                density: float | None = None, seconds: float = 60.0, out_dir: str | Path | None = None,
-               backend: str = "plate", fluid_settings=None, wrap=None, driver=None, extra: dict | None = None) -> dict:
+               backend: str = "plate", fluid_settings=None, wrap=None, driver=None, extra: dict | None = None,
+               seed: int = 0, jitter: StartJitter = START_JITTER) -> dict:
     """Follow ``trajectory``. ``wrap`` and ``driver`` put something else in charge of the
     controller: ``wrap`` goes around it (``Episode``'s), ``driver(episode)`` makes an observer
-    that steers it every step (a learned residual's ``ResidualDriver``); ``extra`` joins the summary."""
+    that steers it every step (a learned residual's ``ResidualDriver``); ``extra`` joins the summary.
+    A non-zero ``seed`` moves the start within ``jitter``."""
     check_seconds(seconds)
     target = load_trajectory(trajectory)
     episode = Episode(stroke, FollowTarget(target), medium=make_medium(density_kg_m3=density, current_m_s=current),
-                      layers=layers, backend=backend, fluid_settings=fluid_settings, wrap=wrap)
+                      layers=layers, backend=backend, fluid_settings=fluid_settings, wrap=wrap, seed=seed, jitter=jitter)
     check_path_in_pool(episode, target, seconds)
     observers = [driver(episode)] if driver is not None else []
     head = {"trajectory": target.name, "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
-            "seconds": seconds, **(extra or {})}
+            "seconds": seconds, "seed": seed, **(extra or {})}
     if out_dir is None:
         swim(episode, seconds, observers)
         return {**head, **episode.metrics(), **fluid_report(episode)}
@@ -258,7 +260,8 @@ def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = L
     write_json(out / "config.json", {COMMAND_KEY: "follow", "trajectory": str(target.source),
                                      "trajectory_spec": _dump(target.spec), "stroke": stroke,
                                      "layers": layers.describe(), "current_m_s": list(current),
-                                     "density_kg_m3": density, "seconds": seconds, "stroke_file": episode.stroke.source,
+                                     "density_kg_m3": density, "seconds": seconds, "seed": seed,
+                                     "start_jitter": asdict(jitter), "stroke_file": episode.stroke.source,
                                      "fluid_backend": {"name": episode.sim.fluid.name,
                                                        "settings": episode.sim.fluid.settings()},
                                      "cycles_per_s_at_tempo_1": 1.0 / episode.stroke.period_s})

@@ -161,6 +161,19 @@ def test_hud_lists_the_figures(session):
     session.paused = False
 
 
+def test_auto_stroke_in_the_app_holds_the_mouse_target_and_the_hud_names_its_choice():
+    s = SwimSession("auto")
+    try:
+        assert s.strokes[-1] == "auto"
+        assert hud_lines(s, 60.0)[0].split() == ["stroke", "auto:", "breaststroke"]
+        s.set_target((1.5, 0.0))              # a click just ahead: reach it, then hold it
+        s.step(480 * 6)
+        assert hud_lines(s, 60.0)[0].split() == ["stroke", "auto:", "treading_water"]
+        assert s.distance_to_target_m < 1.0
+    finally:
+        s.close()
+
+
 def test_frame_writer_png_fallback(tmp_path):
     writer = FrameWriter(tmp_path / "frames", fps=10)
     for shade in (0, 128):

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from layered_swim.config import ConfigError
-from layered_swim.control.targets import (FixedTarget, MovableTarget, Target, TrajectoryTarget,
+from layered_swim.control.targets import (FixedTarget, MovableTarget, StationTarget, Target, TrajectoryTarget,
                                           available_trajectories, load_trajectory)
 
 CURVES = {
@@ -116,13 +116,15 @@ def test_straight_line_file():
 def test_shipped_trajectories_load(name):
     target = load_trajectory(name)
     assert target.name == name and target.description
-    assert target.duration_s > 0 and np.all(np.isfinite(target.path_points()))
-    assert np.all(target.path_points()[:, 2] <= 0.0)
-    assert np.linalg.norm(target.position(0.0)[:2]) < 3.0          # starts near the swimmer
+    assert np.all(np.isfinite(target.path_points())) and np.all(target.path_points()[:, 2] <= 0.0)
+    if target.kind != "stations":          # a fixed or jumping target may be anywhere
+        assert target.duration_s > 0
+        assert np.linalg.norm(target.position(0.0)[:2]) < 3.0      # starts near the swimmer
 
 
 def test_required_files_are_shipped():
-    assert {"figure_eight", "circle", "zigzag", "dive_and_surface", "straight_line"} <= set(available_trajectories())
+    assert {"figure_eight", "circle", "zigzag", "dive_and_surface", "straight_line", "square", "small_loops",
+            "deep_dive", "stationary_behind", "jumping"} <= set(available_trajectories())
     dive = load_trajectory("dive_and_surface").path_points(2000)
     assert dive[:, 2].min() == pytest.approx(-2.0) and dive[0, 2] == dive[-1, 2] == pytest.approx(-0.3)
 
@@ -191,3 +193,36 @@ def test_position_is_cheap(tmp_path):
     for k in range(2000):
         target.position(k / 120.0)
     assert (time.perf_counter() - start) / 2000 < 1e-4
+
+
+STATIONS = textwrap.dedent("""\
+    name: s
+    type: stations
+    stations:
+      - {t_s: 0, x: 4, y: 0, z: -0.3}
+      - {t_s: 25, x: 4, y: -8, z: -1}
+""")
+
+
+def test_a_station_target_holds_each_point_until_its_jump(tmp_path):
+    target = load_trajectory(write(tmp_path, STATIONS))
+    assert isinstance(target, StationTarget) and isinstance(target, Target) and target.kind == "stations"
+    np.testing.assert_allclose(positions(target, [0.0, 24.99, 25.0, 1e4]), [[4, 0, -0.3], [4, 0, -0.3], [4, -8, -1], [4, -8, -1]])
+    assert [t for t, _ in target.stations] == [0.0, 25.0]
+    np.testing.assert_allclose(target.path_points(), [[4, 0, -0.3], [4, -8, -1]])
+
+
+def test_only_a_path_known_ahead_invites_looking_ahead(tmp_path):
+    assert load_trajectory("figure_eight").foresight
+    assert not load_trajectory(write(tmp_path, STATIONS)).foresight          # a jump is not announced
+    assert not FixedTarget([0, 0, -0.3]).foresight and not MovableTarget([0, 0, -0.3]).foresight
+
+
+@pytest.mark.parametrize("text, field", [
+    (STATIONS.replace("t_s: 25", "t_s: 0"), "stations.1.t_s"),
+    (STATIONS.replace("t_s: 0,", "t_s: 1,"), "stations.0.t_s"),
+    (STATIONS.replace("z: -1", "z: 1"), "stations.1.z"),
+])
+def test_bad_stations_name_the_field(tmp_path, text, field):
+    with pytest.raises(ConfigError, match=field.replace(".", r"\.")):
+        load_trajectory(write(tmp_path, text))

@@ -79,6 +79,15 @@ class LayeredController:
         self._roll_n = 0
         self.last_mean_roll_rad: float | None = None
 
+    def restart(self, time_s: float) -> None:
+        """Begin afresh at ``time_s``: its first cycle starts there (a stroke switched in)."""
+        self.reset()
+        self.cycle_start_s = time_s
+
+    def cycle_ends(self, time_s: float) -> bool:
+        """Whether the cycle under way is over at ``time_s`` (or none has begun)."""
+        return self.cycle < 0 or (time_s - self.cycle_start_s) * self.cycles_per_s >= 1.0
+
     @property
     def cycles_per_s(self) -> float:
         return self.choice.tempo / self.stroke.period_s
@@ -105,7 +114,7 @@ class LayeredController:
 
     def desired(self, time_s: float, state: BodyState | None,
                 flow_m_s: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-        while self.cycle < 0 or (time_s - self.cycle_start_s) * self.cycles_per_s >= 1.0:
+        while self.cycle_ends(time_s):
             self._start_cycle(state)
         phase = self.phase(time_s)
         pose, rate = self.stroke.pose(phase)

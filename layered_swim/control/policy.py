@@ -70,7 +70,9 @@ class TargetPolicy:
 
     def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
         position = state.com_m
-        target = self.target.position(state.time_s + self.lead.seconds(self.target, state.time_s))
+        # Aim where the target will be only where its path is known ahead (not a mouse or a jump).
+        ahead_s = self.lead.seconds(self.target, state.time_s) if getattr(self.target, "foresight", True) else 0.0
+        target = self.target.position(state.time_s + ahead_s)
         now = attitude_of(state, self.posture)
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); roll
         # averaged over the last cycle (a crawl rolls +-30 deg within it).

@@ -1,11 +1,15 @@
 """Targets for the swimmer to follow (Yang et al. 2004, section 5): a 3-D point that may move.
 
 A target is fixed, set by the app's mouse (``MovableTarget``), or read from a trajectory file in
-``trajectories/``. Trajectory files describe either a horizontal parametric curve (figure eight,
-circle, sinusoid, line) travelled at a constant speed at a constant depth, or a polyline of timed
-3-D waypoints. Either way the file is turned once into a table of points against a parameter
+``trajectories/``. Trajectory files describe a horizontal parametric curve (figure eight,
+circle, sinusoid, line) travelled at a constant speed at a constant depth, a polyline of timed
+3-D waypoints, or stations: fixed points the target jumps between at given times (a mouse click,
+a buoy moved). Curves and polylines are turned once into a table of points against a parameter
 (arc length in metres for curves, time in seconds for polylines), so ``position()`` is a binary
 search and a linear blend.
+
+``foresight``: whether a swimmer may look ahead along the target's path. A trajectory's future is
+known (the per-cycle layer aims where it will be); a fixed, mouse-moved or jumping target's is not.
 
 World frame: z up, water surface at z = 0, a depth d is z = -d; the swimmer starts at the origin
 heading +x. Angles in files are degrees measured counterclockwise from +x (seen from above).
@@ -44,6 +48,8 @@ def _point(point: Any) -> np.ndarray:
 
 
 class FixedTarget:
+    foresight = False
+
     def __init__(self, point: Any):
         self._point = _point(point)
 
@@ -68,6 +74,8 @@ class TrajectoryTarget:
     arc length; 1 for polylines, where ``u`` is time), starting ``start_s`` seconds along. With
     ``loop`` it wraps from the end of the table to its start, otherwise it stops at the end.
     """
+
+    foresight = True
 
     def __init__(self, points: np.ndarray, u: np.ndarray, rate: float, loop: bool, start_s: float = 0.0,
                  name: str = "", description: str = "", kind: str = "", spec: Strict | None = None,
@@ -96,6 +104,29 @@ class TrajectoryTarget:
     def path_points(self, n: int = 400) -> np.ndarray:
         u = np.linspace(0.0, self._period, max(int(n), 2))
         return np.stack([np.interp(u, self._u, self._points[:, k]) for k in range(3)], axis=1)
+
+
+class StationTarget:
+    """A point that stays at ``points[i]`` from ``times_s[i]`` until the next time, then jumps."""
+
+    foresight = False
+
+    def __init__(self, points: np.ndarray, times_s: np.ndarray, name: str = "", description: str = "",
+                 spec: Strict | None = None, source: str = ""):
+        self._points, self._times_s = np.asarray(points, float), np.asarray(times_s, float)
+        self.name, self.description, self.kind, self.spec, self.source = name, description, "stations", spec, source
+
+    @property
+    def stations(self) -> list[tuple[float, np.ndarray]]:
+        """(time it jumps there, point) for every station, in order."""
+        return [(float(t), p.copy()) for t, p in zip(self._times_s, self._points)]
+
+    def position(self, time_s: float) -> np.ndarray:
+        i = max(int(np.searchsorted(self._times_s, time_s, side="right")) - 1, 0)
+        return self._points[i].copy()
+
+    def path_points(self, n: int = 400) -> np.ndarray:
+        return self._points.copy()
 
 
 # ---------------------------------------------------------------- file schemas
@@ -174,9 +205,17 @@ class PolylineSpec(_Common):
     closing_s: between(0.0, 1e5, above=True) | None = None
 
 
+class StationsSpec(Strict):
+    """Fixed points the target jumps to at ``t_s`` (the first at 0) and holds until the next."""
+    type: Literal["stations"]
+    name: str
+    description: str = ""
+    stations: list[Waypoint] = Field(min_length=1)
+
+
 SPECS: dict[str, type[Strict]] = {
     "figure_eight": FigureEightSpec, "circle": CircleSpec, "sinusoid": SinusoidSpec,
-    "line": LineSpec, "polyline": PolylineSpec,
+    "line": LineSpec, "polyline": PolylineSpec, "stations": StationsSpec,
 }
 
 
@@ -208,18 +247,22 @@ def _curve_xy(spec: _Curve) -> np.ndarray:
     return start + np.outer(s, forward) + np.outer(lateral, left)
 
 
-def _check_polyline(spec: PolylineSpec, source: str) -> None:
-    times = [w.t_s for w in spec.waypoints]
+def _check_timed_points(points: list[Waypoint], field: str, source: str) -> None:
+    times = [w.t_s for w in points]
     if times[0] != 0.0:
-        raise ConfigError(f"{source}: field 'waypoints.0.t_s': the first waypoint must be at t_s 0")
+        raise ConfigError(f"{source}: field '{field}.0.t_s': the first one must be at t_s 0")
     for i in range(1, len(times)):
         if times[i] <= times[i - 1]:
-            raise ConfigError(f"{source}: field 'waypoints.{i}.t_s': times must increase "
+            raise ConfigError(f"{source}: field '{field}.{i}.t_s': times must increase "
                               f"({times[i]:g} after {times[i - 1]:g})")
-    for i, w in enumerate(spec.waypoints):
+    for i, w in enumerate(points):
         if w.z > 0.0:
-            raise ConfigError(f"{source}: field 'waypoints.{i}.z': z is height above the surface "
+            raise ConfigError(f"{source}: field '{field}.{i}.z': z is height above the surface "
                               f"(z = -depth) and must be <= 0, got {w.z:g}")
+
+
+def _check_polyline(spec: PolylineSpec, source: str) -> None:
+    _check_timed_points(spec.waypoints, "waypoints", source)
     if spec.loop and spec.closing_s is None:
         raise ConfigError(f"{source}: field 'closing_s': required when loop is true "
                           "(seconds from the last waypoint back to the first)")
@@ -227,7 +270,11 @@ def _check_polyline(spec: PolylineSpec, source: str) -> None:
         raise ConfigError(f"{source}: field 'closing_s': only used when loop is true")
 
 
-def build_trajectory(spec: Strict, source: str = "") -> TrajectoryTarget:
+def build_trajectory(spec: Strict, source: str = "") -> TrajectoryTarget | StationTarget:
+    if isinstance(spec, StationsSpec):
+        _check_timed_points(spec.stations, "stations", source)
+        return StationTarget(np.array([[w.x, w.y, w.z] for w in spec.stations]),
+                             np.array([w.t_s for w in spec.stations]), spec.name, spec.description, spec, source)
     common = dict(loop=spec.loop, start_s=spec.start_s, name=spec.name, description=spec.description,
                   kind=spec.type, spec=spec, source=source)
     if isinstance(spec, PolylineSpec):
@@ -265,7 +312,7 @@ def trajectory_path(name_or_path: str | Path, directory: Path = TRAJECTORIES_DIR
     return file_path(name_or_path, directory, "trajectory")
 
 
-def load_trajectory(name_or_path: str | Path, directory: Path = TRAJECTORIES_DIR) -> TrajectoryTarget:
+def load_trajectory(name_or_path: str | Path, directory: Path = TRAJECTORIES_DIR) -> TrajectoryTarget | StationTarget:
     """A trajectory by bare name (``figure_eight``) or by path to a YAML file."""
     path = trajectory_path(name_or_path, directory)
     return build_trajectory(parse_trajectory(load_yaml(path), path), str(path))

@@ -1,6 +1,7 @@
 """The HUD text: a session in, lines out (no OpenGL, so it is testable on its own)."""
 from __future__ import annotations
 
+from layered_swim.control.auto import AUTO
 from layered_swim.render.session import SwimSession
 
 
@@ -19,7 +20,7 @@ def hud_lines(session: SwimSession, fps: float, recording: str = "") -> list[str
         clock = f"{s.realtime_factor:.2f}x real time" + (" (slow motion)" if s.slow_motion else "")
     target = "trajectory" if s.target.scripted else f"mouse, depth {s.target_depth_m:.1f} m"
     lines = [
-        f"stroke      {s.stroke}",
+        f"stroke      {s.stroke}" + (f": {s.swimming.name}" if s.stroke == AUTO else ""),
         f"speed       {s.speed_m_s:.2f} m/s    stroke rate {s.stroke_rate_cpm:.0f} /min    phase {s.cycle_phase:.2f}",
         f"weights     {weights}",
         f"layers      basic on  per-cycle {on(layers.cycle)}  palm {on(layers.palm)}  reach {on(layers.reach)}",

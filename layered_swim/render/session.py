@@ -16,6 +16,7 @@ from layered_swim.config import ConfigError
 from layered_swim.control.calibration import CalibrationError
 from layered_swim.control.layered import Layers
 from layered_swim.control.steering import attitude_of
+from layered_swim.control.auto import AUTO
 from layered_swim.control.stroke import available_strokes, stroke_path
 from layered_swim.control.targets import MovableTarget, TrajectoryTarget, load_trajectory
 from layered_swim.episode import Episode
@@ -77,8 +78,9 @@ class SwimSession:
     def __init__(self, stroke: str = "breaststroke", layers: Layers = Layers(), current_m_s=(0.0, 0.0, 0.0),
                  density_kg_m3: float | None = None, trajectory: str | None = None, physics_hz: int = 480,
                  backend: str = "plate", fluid_settings=None, policy=None):
-        self.strokes = available_strokes()
-        stroke_path(stroke)                          # unknown stroke: one-line error before anything opens
+        self.strokes = available_strokes() + [AUTO]
+        if stroke != AUTO:
+            stroke_path(stroke)                      # unknown stroke: one-line error before anything opens
         if stroke not in self.strokes:
             self.strokes.append(stroke)              # a stroke file given by path
         # A learned residual (rl.policy.Policy) drives its own stroke on its own reference controller.
@@ -262,7 +264,12 @@ class SwimSession:
 
     @property
     def heading_rad(self) -> float:
-        return attitude_of(self.sim.state, self.episode.stroke.start.posture).heading_rad
+        return attitude_of(self.sim.state, self.swimming.start.posture).heading_rad
+
+    @property
+    def swimming(self):
+        """The stroke swimming now (``auto`` switches between several)."""
+        return self.sim.controller.stroke
 
     @property
     def target_m(self) -> np.ndarray:

@@ -1,5 +1,11 @@
 """Following a target (a trajectory file, the mouse's point, a fixed point): the swimmer's centre
-of mass against the target over time, and how far apart they were."""
+of mass against the target over time, and how far apart they were.
+
+Beyond the distance, two measures for targets that ask something particular: a target whose depth
+changes is held to its depth while it holds one (``hold_depth_error_m``, the pelvis's depth
+against the target's), and a target that jumps between stations is reached and then held
+(per station: seconds until within ``REACH_M``, then the farthest it drifts until the next jump).
+"""
 from __future__ import annotations
 
 import math
@@ -14,6 +20,9 @@ from layered_swim.tasks import swim_benchmark as bench
 from layered_swim.tasks.base import Task, moved_start
 
 TRACK_HZ = 20      # target-tracking samples per second
+REACH_M = 1.0      # a station is reached within this distance, and held while the swimmer stays within it
+HOLDING_M_S = 0.01         # the target holds its depth while it moves up or down slower than this
+DEPTH_CHANGE_M = 0.1       # a path whose depth varies more than this is checked for depth
 
 
 class FollowTarget(Task):
@@ -30,10 +39,9 @@ class FollowTarget(Task):
 
     def reset(self, episode, rng, **options) -> Start:
         self._every = episode.sim.config.physics_hz // TRACK_HZ
-        self._posture = episode.stroke.start.posture
         self._stroke = episode.stroke.name
         self._samples: dict[str, list] = {"track_time_s": [], "swimmer_m": [], "target_m": [],
-                                          "heading_error_rad": [], "roll_rad": []}
+                                          "pelvis_m": [], "heading_error_rad": [], "roll_rad": []}
         return moved_start(episode.stroke.start_state(), self.start_xy_m, self.start_speed_m_s, self.start_heading_rad)
 
     def observe(self, sim) -> None:
@@ -42,16 +50,18 @@ class FollowTarget(Task):
         state = sim.state
         com = state.com_m
         goal = self.target.position(sim.time_s)
-        att = attitude_of(state, self._posture)
+        att = attitude_of(state, sim.controller.stroke.start.posture)     # the stroke swimming now (auto switches)
         rows = self._samples
         rows["track_time_s"].append(sim.time_s)
         rows["swimmer_m"].append(com)
         rows["target_m"].append(goal)
+        rows["pelvis_m"].append(state.pos("pelvis"))
         rows["heading_error_rad"].append(wrap_angle(math.atan2(goal[1] - com[1], goal[0] - com[0]) - att.heading_rad))
         rows["roll_rad"].append(att.roll_rad)
 
     def track(self) -> dict[str, np.ndarray]:
-        """Per sample: ``track_time_s``, ``swimmer_m`` and ``target_m`` (n, 3), ``heading_error_rad``
+        """Per sample: ``track_time_s``, ``swimmer_m`` (centre of mass), ``target_m`` and ``pelvis_m``
+        (n, 3), ``heading_error_rad``
         (the target's bearing off the heading), ``roll_rad`` (shoulder roll)."""
         return {name: np.array(rows) for name, rows in self._samples.items()}
 
@@ -61,6 +71,9 @@ class FollowTarget(Task):
         result = {"mean_distance_m": float(distance.mean()), "max_distance_m": float(distance.max()),
                   "final_distance_m": float(distance[-1]),
                   "mean_heading_error_deg": float(np.degrees(np.abs(a["heading_error_rad"])).mean())}
+        result.update(hold_depth(a["track_time_s"], a["pelvis_m"], a["target_m"]))
+        if getattr(self.target, "kind", None) == "stations":
+            result.update(station_metrics(a["track_time_s"], distance, [t for t, _ in self.target.stations]))
         if getattr(self.target, "kind", None) == "line":
             # A target moving along a straight line at constant speed: SWIM's metrics apply.
             start = self.target.position(0.0)
@@ -70,3 +83,35 @@ class FollowTarget(Task):
                 a["track_time_s"], a["swimmer_m"], np.degrees(a["roll_rad"]), start, direction, speed,
                 bench.ROLL_TOLERANCE_DEG.get(self._stroke, 45.0))
         return result
+
+
+def hold_depth(time_s: np.ndarray, pelvis_m: np.ndarray, target_m: np.ndarray) -> dict:
+    """For a target whose depth changes: the mean and worst distance between the pelvis's depth and
+    the target's while the target holds a depth; nothing for a target at one depth."""
+    if len(time_s) < 2 or np.ptp(target_m[:, 2]) <= DEPTH_CHANGE_M:
+        return {}
+    holding = np.abs(np.gradient(target_m[:, 2], time_s)) < HOLDING_M_S
+    error = np.abs(pelvis_m[holding, 2] - target_m[holding, 2])
+    if not len(error):
+        return {}
+    return {"hold_depth_error_m": float(error.mean()), "hold_depth_error_max_m": float(error.max())}
+
+
+def station_metrics(time_s: np.ndarray, distance_m: np.ndarray, jumps_s: list[float]) -> dict:
+    """Per station: ``reach_s``, seconds from its jump until within REACH_M (None: never), and
+    ``held_within_m``, the farthest the swimmer was from it after that until the next jump."""
+    ends = jumps_s[1:] + [float("inf")]
+    stations = []
+    for start, end in zip(jumps_s, ends):
+        window = (time_s >= start) & (time_s < end)
+        if not window.any():
+            break                      # the run ended before this jump
+        t, d = time_s[window], distance_m[window]
+        inside = np.flatnonzero(d <= REACH_M)
+        reached = inside[0] if len(inside) else None
+        stations.append({"t_s": start, "reach_s": None if reached is None else float(t[reached] - start),
+                         "held_within_m": None if reached is None else float(d[reached:].max())})
+    reached_all = all(s["reach_s"] is not None for s in stations)
+    return {"stations": stations, "reached_all": reached_all,
+            "worst_reach_s": max(s["reach_s"] for s in stations) if reached_all else None,
+            "worst_held_within_m": max(s["held_within_m"] for s in stations) if reached_all else None}

@@ -1,0 +1,64 @@
+"""`--stroke auto`: which stroke the rule picks, that a switch never jumps the pose, and that it
+holds a target that stays put by treading water."""
+import math
+
+import numpy as np
+import pytest
+
+from layered_swim.config import ConfigError
+from layered_swim.control.auto import HOLD, SPRINT, TURN, StrokeChoice, target_speed_m_s
+from layered_swim.control.targets import FixedTarget, StationTarget, load_trajectory
+from layered_swim.episode import Episode
+from layered_swim.tasks import FollowTarget
+
+RULE = StrokeChoice()
+AHEAD, BEHIND = 0.0, math.radians(150.0)
+
+
+@pytest.mark.parametrize("active, distance, speed, error, expected", [
+    (TURN, 0.8, 0.0, BEHIND, HOLD),       # a still target close by is held, wherever it is
+    (TURN, 0.8, 0.5, AHEAD, TURN),        # a moving one is followed
+    (HOLD, 1.5, 0.0, BEHIND, HOLD),       # treading goes on until the target is hold_leave_m away...
+    (TURN, 1.5, 0.0, AHEAD, TURN),        # ...but does not start until within hold_within_m
+    (HOLD, 2.5, 0.0, AHEAD, TURN),
+    (HOLD, 1.5, 0.5, AHEAD, TURN),        # or until it moves
+    (TURN, 8.0, 0.5, AHEAD, SPRINT),      # far ahead: sprint
+    (TURN, 8.0, 0.5, BEHIND, TURN),       # far behind: turn first
+    (SPRINT, 4.0, 0.5, math.radians(45.0), SPRINT),   # a sprint keeps on to sprint_until_m...
+    (TURN, 4.0, 0.5, AHEAD, TURN),        # ...which a turn does not start from
+    (SPRINT, 2.0, 0.5, AHEAD, TURN),
+    (SPRINT, 8.0, 0.5, math.radians(70.0), TURN),
+])
+def test_the_rule_picks_the_stroke_for_what_the_target_asks(active, distance, speed, error, expected):
+    assert RULE.choose(active, distance, speed, error) == expected
+
+
+def test_target_speed_looks_ahead_only_where_the_path_is_known():
+    line = load_trajectory("straight_line")
+    assert target_speed_m_s(line, 5.0) == pytest.approx(float(np.linalg.norm(line.position(6.0) - line.position(5.0))))
+    jump = StationTarget(np.array([[0.0, 0.0, -0.3], [4.0, 3.0, -0.3]]), np.array([0.0, 10.0]))
+    assert target_speed_m_s(jump, 9.5) == 0.0                  # the jump is not seen coming
+    assert target_speed_m_s(jump, 10.5) == pytest.approx(5.0)   # it moved 5 m within the last second
+    assert target_speed_m_s(jump, 12.0) == 0.0
+
+
+def test_auto_holds_a_still_target_by_treading_water_and_never_jumps_the_pose():
+    episode = Episode("auto", FollowTarget(FixedTarget([2.5, 0.0, -0.3])))
+    poses = []
+    try:
+        episode.run(14.0, observers=[lambda sim: poses.append(sim.desired_pose.copy())])
+        controller, state = episode.controller, episode.sim.state
+    finally:
+        episode.close()
+    assert controller.switches and controller.switches[0][1] == HOLD and controller.active == HOLD
+    assert np.linalg.norm(state.com_m[:2] - [2.5, 0.0]) < 1.0
+    steps = np.abs(np.diff(np.array(poses), axis=0)).max(axis=1)
+    hz = episode.sim.config.physics_hz
+    switch = int(round(controller.switches[0][0] * hz))
+    # Across the switch the pose moves no faster than the strokes themselves move it.
+    assert steps[switch - 5:switch + 5].max() <= 1.5 * np.percentile(steps, 99.9)
+
+
+def test_auto_needs_a_target():
+    with pytest.raises(ConfigError, match="auto"):
+        Episode("auto")

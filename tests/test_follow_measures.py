@@ -1,0 +1,88 @@
+"""What `follow` measures beyond the distance (depth during holds, reaching and holding stations),
+how far a seed moves the start, and the medians over perturbed starts (`follow --seeds`)."""
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from layered_swim.analysis.robustness import spread
+from layered_swim.control.policy import TargetPolicy
+from layered_swim.control.targets import StationTarget
+from layered_swim.episode import START_JITTER, WIDE_JITTER, jittered_start
+from layered_swim.state import Start
+from layered_swim.tasks.follow import hold_depth, station_metrics
+
+from test_layered_control import still_state, table
+
+
+def test_depth_is_checked_only_while_the_target_holds_one():
+    t = np.arange(0.0, 30.0, 1.0)
+    target = np.zeros((30, 3))
+    target[:, 2] = np.interp(t, [0, 10, 20, 29], [-0.3, -0.3, -2.3, -2.3])   # holds, dives 2 m over 10 s, holds
+    pelvis = target.copy()
+    pelvis[:, 2] += 0.5                           # always 0.5 m shallower...
+    pelvis[25:, 2] = target[25:, 2] + 0.1         # ...but for the last 5 samples
+    got = hold_depth(t, pelvis, target)
+    holding = (t <= 9) | (t >= 21)                # np.gradient blurs the corners by one sample
+    expected = np.where(t[holding] >= 25, 0.1, 0.5)
+    assert got["hold_depth_error_m"] == pytest.approx(expected.mean())
+    assert got["hold_depth_error_max_m"] == pytest.approx(0.5)
+    assert hold_depth(t, pelvis, np.zeros((30, 3)) - 0.3) == {}      # one depth: nothing to hold
+
+
+def test_each_station_is_timed_to_reach_and_then_held():
+    t = np.arange(0.0, 20.0, 0.5)
+    d = np.where(t < 10, np.maximum(5.0 - t, 0.2), np.maximum(15.0 - t, 0.6))   # closes in at 1 m/s, twice
+    d[(t >= 6) & (t < 7)] = 1.4                   # drifts out once while holding the first
+    got = station_metrics(t, d, [0.0, 10.0])
+    assert got["stations"] == [{"t_s": 0.0, "reach_s": 4.0, "held_within_m": 1.4},
+                               {"t_s": 10.0, "reach_s": 4.0, "held_within_m": 1.0}]
+    assert got["reached_all"] and got["worst_reach_s"] == 4.0 and got["worst_held_within_m"] == 1.4
+    never = station_metrics(t, np.full(len(t), 3.0), [0.0, 10.0])
+    assert not never["reached_all"] and never["worst_reach_s"] is None
+    assert [s["reach_s"] for s in never["stations"]] == [None, None]
+    assert len(station_metrics(t, d, [0.0, 10.0, 50.0])["stations"]) == 2       # the run ended before the last jump
+
+
+@pytest.mark.parametrize("jitter", [START_JITTER, WIDE_JITTER])
+def test_a_seed_moves_the_start_within_its_jitter(jitter):
+    start = Start("prone", 0.15, 0.6, 0.0, (0.0, 0.0))
+    moved = [jittered_start(start, np.random.default_rng(seed), jitter) for seed in range(1, 200)]
+    headings = np.array([m.heading_rad for m in moved])
+    xy = np.array([m.position_xy_m for m in moved])
+    assert np.abs(headings).max() <= jitter.heading_rad and np.abs(xy).max() <= jitter.position_m
+    assert np.abs(headings).max() > 0.9 * jitter.heading_rad and np.abs(xy).max() > 0.9 * jitter.position_m
+    assert WIDE_JITTER.heading_rad == pytest.approx(math.radians(10.0)) and WIDE_JITTER.position_m == 0.3
+
+
+def test_a_jumping_target_is_not_anticipated():
+    """One second before the target jumps behind, the swimmer still heads for where it is."""
+    target = StationTarget(np.array([[5.0, 0.0, 0.0], [-5.0, 0.0, 0.0]]), np.array([0.0, 1.0]))
+    state = still_state(np.full(16, 1 / 16))
+    assert TargetPolicy(target, table(), "prone")(0, state, 0.0).thrust_demand == pytest.approx(1.0)
+
+
+def test_medians_count_a_run_that_never_got_there_as_worst():
+    assert spread([3.0, 1.0, 2.0]) == {"median": 2.0, "min": 1.0, "max": 3.0}
+    assert spread([3.0, None, None]) == {"median": None, "min": 3.0, "max": None}
+    assert spread([None, None]) is None
+
+
+def test_follow_seeds_reports_medians_over_perturbed_starts(tmp_path):
+    out = tmp_path / "seeds"
+    run = subprocess.run([sys.executable, "-m", "layered_swim", "follow", "jumping", "--seconds", "1", "--seeds", "2",
+                          "--workers", "1", "--json", "--out", str(out)], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    summary = json.loads(run.stdout)
+    assert [r["seed"] for r in summary["runs"]] == [1, 2] and summary["start_jitter"]["position_m"] == 0.3
+    distances = [r["mean_distance_m"] for r in summary["runs"]]
+    assert distances[0] != distances[1]                       # two different starts
+    assert summary["median"]["mean_distance_m"]["median"] == pytest.approx(np.median(distances))
+    assert summary["reached_all_share"] == 0.0                # 4 m away, one second
+    assert json.loads((out / "summary.json").read_text())["runs"] == summary["runs"]
+    refused = subprocess.run([sys.executable, "-m", "layered_swim", "follow", "jumping", "--seconds", "1", "--seeds", "2",
+                              "--backend", "sph"], capture_output=True, text=True, timeout=300)
+    assert refused.returncode == 2 and refused.stderr.count("\n") == 1 and "--seeds" in refused.stderr
