@@ -38,6 +38,7 @@ from layered_swim.control.auto import AUTO, AUTO_STROKES, AutoStrokeController
 from layered_swim.control.basic import StrokeController
 from layered_swim.control.calibration import load_table
 from layered_swim.control.layered import Layers, LayeredController, WeightPolicy, fixed_weights
+from layered_swim.control.lungs import LungControl
 from layered_swim.control.policy import TargetPolicy, TempoControl
 from layered_swim.control.rules import arm_indices
 from layered_swim.control.steering import SteeringGains
@@ -212,4 +213,5 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
             weights = TargetPolicy(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace)
         else:
             weights = fixed_weights({}, tempo=tempo)
-    return LayeredController(stroke, layout, arm_indices(body, layout), weights, layers, target)
+    lungs = LungControl(body.lung_air_l, body.max_lung_air_l) if stroke.steering.breathe else None
+    return LayeredController(stroke, layout, arm_indices(body, layout), weights, layers, target, lungs)

@@ -6,7 +6,7 @@ axes, ranges and PD gains. Everything is SI; degrees exist only in the file.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
 from typing import Literal
@@ -86,6 +86,7 @@ class LungSpec(Strict):
     segment: str
     residual_volume_l: between(0.0, 10.0)
     default_air_l: between(0.0, 10.0)
+    max_air_l: between(0.0, 10.0) = 5.5      # the most air a breath adds above the residual volume
 
 
 class BodySpec(Strict):
@@ -159,6 +160,8 @@ class Body:
     joints: tuple[Joint, ...]          # in segment order
     gimbal_mass_kg: float
     lung_air_l: float
+    lung_segment: str
+    max_lung_air_l: float
     source: str
 
     @property
@@ -182,6 +185,16 @@ class Body:
 
     def index(self, segment: str) -> int:
         return self.segment_names.index(segment)
+
+    def breathing(self, air_l: float) -> "Body":
+        """The same body holding ``air_l`` of air above the residual volume: its lung segment
+        displaces the difference, its buoyancy ellipsoid grows with it."""
+        i = self.index(self.lung_segment)
+        volume = self.volume_m3.copy()
+        volume[i] += (air_l - self.lung_air_l) * 1e-3
+        semi = self.semi_axes_m.copy()
+        semi[i] = equal_volume_semi_axes(self.half_extents_m[i], volume[i])
+        return replace(self, volume_m3=volume, semi_axes_m=semi, lung_air_l=float(air_l))
 
     def joint(self, name: str) -> Joint:
         for joint in self.joints:
@@ -238,7 +251,7 @@ def resolve_body(spec: BodySpec, lung_air_l: float, source: str) -> Body:
         center_m=np.array([s.center_m.as_tuple() for s in segs]),
         volume_m3=volume, semi_axes_m=equal_volume_semi_axes(half, volume),
         joints=tuple(joints), gimbal_mass_kg=spec.gimbal_mass_kg, lung_air_l=lung_air_l,
-        source=source,
+        lung_segment=spec.lungs.segment, max_lung_air_l=spec.lungs.max_air_l, source=source,
     )
 
 

@@ -74,6 +74,7 @@ class AutoStrokeController:
         for controller in self.controllers.values():
             controller.reset()
         self.switches: list[tuple[float, str]] = []
+        self.lung_air_l: float | None = self.current.lung_air_l    # kept through strokes that do not breathe
         self._from_pose: np.ndarray | None = None
         self._last_pose: np.ndarray | None = None
         self._switched_s = 0.0
@@ -114,6 +115,8 @@ class AutoStrokeController:
             if wanted != self.active:
                 self._switch(wanted, time_s)
         pose, rate = self.current.desired(time_s, state, flow_m_s)
+        if self.current.lung_air_l is not None:
+            self.lung_air_l = self.current.lung_air_l
         if self._from_pose is not None:
             progress = (time_s - self._switched_s) / self.choice_rule.blend_s
             if progress >= 1.0:
@@ -138,4 +141,6 @@ class AutoStrokeController:
         self._switched_s = time_s
         self.active = name
         self.current.restart(time_s)
+        if self.current.lung_air_l is not None and self.lung_air_l is not None:
+            self.current.lung_air_l = self.lung_air_l        # the breath held goes on
         self.switches.append((time_s, name))

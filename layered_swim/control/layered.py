@@ -3,7 +3,9 @@
 At the start of every stroke cycle a weight policy picks one weight per perturbation sequence
 (and the cycle's tempo); the weights scale and blend the sequences' offsets into the basic pose
 for that whole cycle. Every control step the continuous rules adjust the blended pose from the
-water flowing past the hands. Layers can be switched off one by one (``Layers``).
+water flowing past the hands. Layers can be switched off one by one (``Layers``). A stroke that
+breathes to steer (``steering.breathe``) also sets the air in the lungs toward the target's depth
+(``control/lungs.py``); the simulation hands it to the fluid.
 """
 from __future__ import annotations
 
@@ -13,6 +15,7 @@ from typing import Protocol
 import numpy as np
 
 from layered_swim.config import ConfigError
+from layered_swim.control.lungs import LungControl
 from layered_swim.control.rules import ArmIndices, rule_offsets
 from layered_swim.control.steering import forward_axis, shoulder_roll
 from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
@@ -62,10 +65,12 @@ class WeightPolicy(Protocol):
 
 class LayeredController:
     def __init__(self, stroke: Stroke, layout: JointLayout, arms: list[ArmIndices], policy: WeightPolicy,
-                 layers: Layers = Layers(), target: Target | None = None):
-        """``target``: where the rules push toward; without one, straight ahead (scripted policies)."""
+                 layers: Layers = Layers(), target: Target | None = None, lungs: LungControl | None = None):
+        """``target``: where the rules push toward; without one, straight ahead (scripted policies).
+        ``lungs``: breathe toward the target's depth (needs a target)."""
         self.stroke, self.layout, self.arms, self.policy, self.layers = stroke, layout, arms, policy, layers
         self.target = target
+        self.lungs = lungs if target is not None else None
         self.reset()
 
     def reset(self) -> None:
@@ -78,6 +83,9 @@ class LayeredController:
         self._roll_sum = 0.0
         self._roll_n = 0
         self.last_mean_roll_rad: float | None = None
+        # The air the swimmer holds (None: it does not breathe to steer), and when it last changed.
+        self.lung_air_l = self.lungs.rest_air_l if self.lungs is not None else None
+        self._last_breath_s: float | None = None
 
     def restart(self, time_s: float) -> None:
         """Begin afresh at ``time_s``: its first cycle starts there (a stroke switched in)."""
@@ -131,6 +139,8 @@ class LayeredController:
                 rate = rate + weight * offset_rate
         if state is not None:
             self._track_roll(state)
+            if self.lungs is not None and self.layers.cycle:      # depth is steered, like the heading
+                self._breathe(time_s, state)
             if self.layers.palm or self.layers.reach:
                 dt_s = time_s - self._last_rule_time_s if self._last_rule_time_s is not None else 0.0
                 self._last_rule_time_s = time_s
@@ -168,6 +178,12 @@ class LayeredController:
         forward = forward_axis(state.quat("pelvis"), self.stroke.start.posture)
         turning = max(self.choice.weights.get("yaw_left", 0.0), self.choice.weights.get("yaw_right", 0.0))
         return max(0.0, float(forward @ desired)) ** 2 * max(0.0, 1.0 - turning) ** 3 * self.choice.thrust_demand
+
+    def _breathe(self, time_s: float, state: BodyState) -> None:
+        dt_s = time_s - self._last_breath_s if self._last_breath_s is not None else 0.0
+        self._last_breath_s = time_s
+        self.lung_air_l = self.lungs.next_air_l(self.lung_air_l, -float(state.pos("pelvis")[2]),
+                                                -float(self.target.position(time_s)[2]), dt_s)
 
     def _track_roll(self, state: BodyState) -> None:
         """Accumulate the cycle's mean shoulder roll: a crawl rolls +-30 deg within a cycle, so

@@ -86,6 +86,7 @@ class SteeringSpec(Strict):
     min_tempo: float = Field(0.5, ge=0.1, le=1.0)
     glide_within_m: float = Field(0.0, ge=0.0, le=10.0)
     glide_moving_joints: list[str] = []
+    breathe: bool = False           # breathe out to sink and in to rise toward the target's depth
 
 
 class StrokeSpec(Strict):

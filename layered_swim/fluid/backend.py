@@ -50,6 +50,14 @@ class FluidBackend:
         """The water changes mid-swim (the app's density and current keys)."""
         self.medium = medium
 
+    # Whether ``breathe`` changes what the water does: the SPH pool's boxes displace what their
+    # geometry does, whatever the lungs hold.
+    breathes = True
+
+    def breathe(self, air_l: float) -> None:
+        """The swimmer now holds ``air_l`` of air (above the residual volume): its buoyancy changes."""
+        self.body = self.body.breathing(air_l)
+
     def settings(self) -> dict:
         """The model's own settings, JSON-able, for the run's resolved config."""
         return {}

@@ -94,10 +94,18 @@ class PlateFluid(FluidBackend):
         super().__init__(body, medium, gravity_m_s2)
         self.plate_settings = settings or PlateSettings()
         self.table = build_coefficient_table()
-        self._segments = np.ascontiguousarray(np.column_stack(
-            [body.half_extents_m, body.semi_axes_m, body.mass_fraction, body.volume_m3]), dtype=np.float64)
+        self._segments = self._pack(body)
         self._coefficients = np.ascontiguousarray(np.vstack(self.table), dtype=np.float64)
         self.set_medium(medium)
+
+    @staticmethod
+    def _pack(body: Body) -> np.ndarray:
+        return np.ascontiguousarray(np.column_stack(
+            [body.half_extents_m, body.semi_axes_m, body.mass_fraction, body.volume_m3]), dtype=np.float64)
+
+    def breathe(self, air_l: float) -> None:
+        super().breathe(air_l)
+        self._segments = self._pack(self.body)
 
     def set_medium(self, medium: Medium) -> None:
         super().set_medium(medium)

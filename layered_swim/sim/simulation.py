@@ -82,6 +82,7 @@ class Simulation:
         # mass, world frame; None until the first ``push``, so a plain swim does no extra work.
         self.external_force_n: np.ndarray | None = None
         self.desired_pose = self.desired_rate = None
+        self.lung_air_l = body.lung_air_l      # what the fluid's body holds now
 
     @property
     def time_s(self) -> float:
@@ -99,6 +100,7 @@ class Simulation:
         velocity = (start.speed_m_s * math.cos(heading), start.speed_m_s * math.sin(heading), 0.0)
         self.controller.reset()
         self.fluid.reset()
+        self._breathe(self.body.lung_air_l)
         pose, _ = self.controller.desired(0.0, None, None)  # the stroke's pose at phase 0 needs no state
         root_m = np.array([*start.position_xy_m, -start.depth_m])
         self.world.reset(root_m, quat, pose, velocity)
@@ -110,6 +112,11 @@ class Simulation:
         self.external_force_n = None
         self.fluid_now = _still(len(self.body.segment_names))
         self.state = self.world.read_state()
+
+    def _breathe(self, air_l: float) -> None:
+        if air_l != self.lung_air_l and self.fluid.breathes:
+            self.fluid.breathe(air_l)
+            self.lung_air_l = air_l
 
     def push(self, force_n, segment: str = "pelvis") -> None:
         """Push ``segment`` with ``force_n`` (world frame, at its centre of mass) on every step
@@ -125,6 +132,9 @@ class Simulation:
         if self.steps % self.control_every == 0:
             self.desired_pose, self.desired_rate = self.controller.desired(self.world.time_s, state, fluid.flow_m_s)
             self.world.set_targets(self.desired_pose, self.desired_rate)
+            air = getattr(self.controller, "lung_air_l", None)    # a stroke that breathes to steer
+            if air is not None:
+                self._breathe(air)
         force = fluid.force_n if self.external_force_n is None else fluid.force_n + self.external_force_n
         self.world.apply_wrenches(force, fluid.torque_nm, state.pos_m)
         self.world.drive()

@@ -36,6 +36,7 @@ FLOW_HZ = 120                  # the water velocity at the segments is sampled a
 
 class SphBackend(FluidBackend):
     name = "sph"
+    breathes = False     # each box displaces the water its geometry does: lung air is not modelled
 
     def __init__(self, body: Body, medium: Medium, gravity_m_s2: float, settings: SphSettings | None = None):
         super().__init__(body, medium, gravity_m_s2)
