@@ -208,7 +208,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
     if weights is None:
         steer = stroke.steering
         if layers.cycle:
-            pace = tempo_control or TempoControl(min_tempo=steer.min_tempo, glide_within_m=steer.glide_within_m)
+            pace = tempo_control or TempoControl(min_tempo=steer.min_tempo, glide_within_m=steer.glide_within_m,
+                                                 wide_turn_rad=math.radians(steer.wide_turn_deg))
             gains = SteeringGains(steer.yaw_fraction, steer.pitch_fraction, steer.roll_fraction)
             weights = TargetPolicy(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace)
         else:

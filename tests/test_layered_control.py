@@ -131,6 +131,11 @@ def test_steering_settings_come_from_the_stroke_file_and_leave_its_calibration_f
     gains = crawl.controller.policy.gains
     assert (gains.yaw_fraction, gains.pitch_fraction, gains.roll_fraction) == (
         steering.yaw_fraction, steering.pitch_fraction, steering.roll_fraction)
+    assert crawl.controller.policy.tempo_control.min_tempo == steering.min_tempo
+    breast = Episode("breaststroke", FollowTarget(FixedTarget([5.0, 0.0, -0.3])))
+    breast.close()
+    assert breast.controller.policy.tempo_control.wide_turn_rad == pytest.approx(math.radians(180.0))
+    assert breast.controller.lungs is not None and crawl.controller.lungs is None
     spec = load(StrokeSpec, stroke_path("front_crawl"))
     edited = spec.model_copy(update={"steering": spec.steering.model_copy(update={"yaw_fraction": 0.1})})
     assert build_stroke(edited, LAYOUT, "x").spec_sha256 == crawl.stroke.spec_sha256

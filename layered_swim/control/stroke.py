@@ -86,6 +86,8 @@ class SteeringSpec(Strict):
     min_tempo: float = Field(0.5, ge=0.1, le=1.0)
     glide_within_m: float = Field(0.0, ge=0.0, le=10.0)
     glide_moving_joints: list[str] = []
+    # The tempo falls from full with the target 30 deg off the heading to min_tempo this far off.
+    wide_turn_deg: float = Field(90.0, gt=30.0, le=180.0)
     breathe: bool = False           # breathe out to sink and in to rise toward the target's depth
 
 
