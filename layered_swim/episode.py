@@ -80,12 +80,13 @@ class Episode:
         self.seed, self.jitter = seed, jitter
         self.body = load_body(lung_air_l=lung_air_l)
         layout = joint_layout(self.body)
-        names = AUTO_STROKES if stroke == AUTO else (stroke,)
-        specs = {name: load(StrokeSpec, stroke_path(name)) for name in names}    # as validated, for config.json
-        strokes = {name: build_stroke(spec, layout, str(stroke_path(name))) for name, spec in specs.items()}
+        paths = {name: stroke_path(name) for name in (AUTO_STROKES if stroke == AUTO else (stroke,))}
+        specs = {name: load(StrokeSpec, path) for name, path in paths.items()}    # as validated, for config.json
+        strokes = {name: build_stroke(specs[name], layout, str(path)) for name, path in paths.items()}
         # The start and the config are the first stroke's (the one ``auto`` starts with).
-        self.stroke_spec: StrokeSpec = specs[names[0]]
-        self.stroke: Stroke = strokes[names[0]]
+        first = next(iter(paths))
+        self.stroke_spec: StrokeSpec = specs[first]
+        self.stroke: Stroke = strokes[first]
         if stroke == AUTO:
             if self.task.target is None or weights is not None or not layers.cycle:
                 raise ConfigError("--stroke auto chooses strokes to chase a target: it needs one (follow, goal, "

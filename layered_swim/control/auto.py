@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from layered_swim.control.layered import LayeredController
-from layered_swim.control.steering import attitude_of, wrap_angle
+from layered_swim.control.layered import LayeredController, ease
+from layered_swim.control.steering import attitude_of, bearing_error
 from layered_swim.control.targets import Target
 from layered_swim.state import BodyState
 
@@ -122,19 +122,18 @@ class AutoStrokeController:
             if progress >= 1.0:
                 self._from_pose = None
             else:
-                ease = progress * progress * (3.0 - 2.0 * progress)
-                pose = self._from_pose + ease * (pose - self._from_pose)
-                rate = ease * rate
+                eased = ease(progress)
+                pose = self._from_pose + eased * (pose - self._from_pose)
+                rate = eased * rate
         self._last_pose = pose
         return pose, rate
 
     def _wanted(self, state: BodyState) -> str:
-        goal = self.target.position(state.time_s)
-        delta = goal - state.com_m
+        goal, position = self.target.position(state.time_s), state.com_m
         heading = attitude_of(state, self.current.stroke.start.posture).heading_rad
-        error = wrap_angle(math.atan2(delta[1], delta[0]) - heading)
-        return self.choice_rule.choose(self.active, float(np.linalg.norm(delta)),
-                                       target_speed_m_s(self.target, state.time_s), error)
+        return self.choice_rule.choose(self.active, float(np.linalg.norm(goal - position)),
+                                       target_speed_m_s(self.target, state.time_s),
+                                       bearing_error(position, goal, heading))
 
     def _switch(self, name: str, time_s: float) -> None:
         self._from_pose = None if self._last_pose is None else self._last_pose.copy()

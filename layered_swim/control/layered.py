@@ -27,6 +27,11 @@ from layered_swim.state import BodyState, JointLayout
 BLEND_CYCLES = 0.15   # a new cycle's weights take over within this fraction of it
 
 
+def ease(progress: float) -> float:
+    """0 to 1 as ``progress`` goes 0 to 1, flat at both ends (smoothstep): a blend with no kink."""
+    return progress * progress * (3.0 - 2.0 * progress)
+
+
 @dataclass(frozen=True)
 class Layers:
     cycle: bool = True
@@ -164,10 +169,10 @@ class LayeredController:
         progress = (time_s - self.cycle_start_s) * self.cycles_per_s / BLEND_CYCLES
         if progress >= 1.0 or not self._previous_weights:
             return self.choice.weights
-        ease = progress * progress * (3.0 - 2.0 * progress)
+        eased = ease(progress)
         # A fixed order: the offsets are summed in it, and a set's order changes with the hash seed.
         names = [n for n in SEQUENCE_NAMES if n in self.choice.weights or n in self._previous_weights]
-        return {n: self._previous_weights.get(n, 0.0) + ease * (self.choice.weights.get(n, 0.0) - self._previous_weights.get(n, 0.0))
+        return {n: self._previous_weights.get(n, 0.0) + eased * (self.choice.weights.get(n, 0.0) - self._previous_weights.get(n, 0.0))
                 for n in names}
 
     def _engagement(self, state: BodyState, desired: np.ndarray) -> float:

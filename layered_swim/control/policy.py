@@ -15,7 +15,7 @@ import numpy as np
 
 from layered_swim.control.calibration import CalibrationTable
 from layered_swim.control.layered import CycleChoice
-from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, wanted_turns, wrap_angle
+from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, bearing_error, wanted_turns
 from layered_swim.control.targets import Target
 from layered_swim.state import BodyState
 
@@ -77,7 +77,7 @@ class TargetPolicy:
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); roll
         # averaged over the last cycle (a crawl rolls +-30 deg within it).
         att = Attitude(now.heading_rad, now.pitch_rad, now.roll_rad if mean_roll_rad is None else mean_roll_rad)
-        heading_error = wrap_angle(math.atan2(target[1] - position[1], target[0] - position[0]) - att.heading_rad)
+        heading_error = bearing_error(position, target, att.heading_rad)
         distance = float(np.linalg.norm(self.target.position(state.time_s) - position))
         drive = self.tempo_control.drive(distance, heading_error)
         tempo = self.tempo_control.tempo_for(drive)

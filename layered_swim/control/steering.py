@@ -23,6 +23,11 @@ def wrap_angle(a: float) -> float:
     return (a + math.pi) % (2 * math.pi) - math.pi
 
 
+def bearing_error(position_m: np.ndarray, target_m: np.ndarray, heading_rad: float) -> float:
+    """How far the target's bearing from ``position_m`` lies off the heading (+ to the left)."""
+    return wrap_angle(math.atan2(target_m[1] - position_m[1], target_m[0] - position_m[0]) - heading_rad)
+
+
 @dataclass(frozen=True)
 class Attitude:
     heading_rad: float

@@ -94,18 +94,18 @@ class PlateFluid(FluidBackend):
         super().__init__(body, medium, gravity_m_s2)
         self.plate_settings = settings or PlateSettings()
         self.table = build_coefficient_table()
-        self._segments = self._pack(body)
+        self._segments = np.ascontiguousarray(np.column_stack(
+            [body.half_extents_m, body.semi_axes_m, body.mass_fraction, body.volume_m3]), dtype=np.float64)
         self._coefficients = np.ascontiguousarray(np.vstack(self.table), dtype=np.float64)
         self.set_medium(medium)
 
-    @staticmethod
-    def _pack(body: Body) -> np.ndarray:
-        return np.ascontiguousarray(np.column_stack(
-            [body.half_extents_m, body.semi_axes_m, body.mass_fraction, body.volume_m3]), dtype=np.float64)
-
     def breathe(self, air_l: float) -> None:
         super().breathe(air_l)
-        self._segments = self._pack(self.body)
+        # Only the lung segment's volume and ellipsoid change; this runs every control step while
+        # the lungs fill or empty, so the rest of the table stays.
+        i = self.body.index(self.body.lung_segment)
+        self._segments[i, 3:6] = self.body.semi_axes_m[i]
+        self._segments[i, 7] = self.body.volume_m3[i]
 
     def set_medium(self, medium: Medium) -> None:
         super().set_medium(medium)

@@ -82,7 +82,6 @@ class Simulation:
         # mass, world frame; None until the first ``push``, so a plain swim does no extra work.
         self.external_force_n: np.ndarray | None = None
         self.desired_pose = self.desired_rate = None
-        self.lung_air_l = body.lung_air_l      # what the fluid's body holds now
 
     @property
     def time_s(self) -> float:
@@ -113,10 +112,14 @@ class Simulation:
         self.fluid_now = _still(len(self.body.segment_names))
         self.state = self.world.read_state()
 
+    @property
+    def lung_air_l(self) -> float:
+        """The air the swimmer holds now, as the fluid sees it."""
+        return self.fluid.body.lung_air_l
+
     def _breathe(self, air_l: float) -> None:
         if air_l != self.lung_air_l and self.fluid.breathes:
             self.fluid.breathe(air_l)
-            self.lung_air_l = air_l
 
     def push(self, force_n, segment: str = "pelvis") -> None:
         """Push ``segment`` with ``force_n`` (world frame, at its centre of mass) on every step

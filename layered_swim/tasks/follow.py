@@ -8,11 +8,9 @@ against the target's), and a target that jumps between stations is reached and t
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from layered_swim.control.steering import attitude_of, wrap_angle
+from layered_swim.control.steering import attitude_of, bearing_error
 from layered_swim.control.targets import Target
 from layered_swim.geometry import unit_vector
 from layered_swim.state import Start
@@ -56,7 +54,7 @@ class FollowTarget(Task):
         rows["swimmer_m"].append(com)
         rows["target_m"].append(goal)
         rows["pelvis_m"].append(state.pos("pelvis"))
-        rows["heading_error_rad"].append(wrap_angle(math.atan2(goal[1] - com[1], goal[0] - com[0]) - att.heading_rad))
+        rows["heading_error_rad"].append(bearing_error(com, goal, att.heading_rad))
         rows["roll_rad"].append(att.roll_rad)
 
     def track(self) -> dict[str, np.ndarray]:
