@@ -65,10 +65,19 @@ class BodyState:
         return self.segments.centre_of_mass(self.linvel_m_s)
 
 
+POSTURES = ("prone", "supine", "upright")
+
+
+def lying(posture: str) -> bool:
+    """Prone and supine strokes swim along the body's long axis; upright ones do not travel."""
+    return posture != "upright"
+
+
 @dataclass(frozen=True)
 class Start:
-    """Where and how a swim starts: posture (``prone`` lies face down heading +x, ``upright``
-    stands), pelvis depth, forward speed, heading (rad, from +x toward +y) and position."""
+    """Where and how a swim starts: posture (``prone`` lies face down heading +x, ``supine`` face
+    up heading +x, ``upright`` stands), pelvis depth, forward speed, heading (rad, from +x toward
+    +y) and position."""
 
     posture: str = "prone"
     depth_m: float = 0.1

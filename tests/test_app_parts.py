@@ -144,7 +144,7 @@ def test_session_target_and_depth(session):
 
 def test_session_rejects_bad_input():
     with pytest.raises(ConfigError, match="unknown stroke"):
-        SwimSession("butterfly")
+        SwimSession("dog_paddle")
     with pytest.raises(ConfigError, match="unknown trajectory"):
         SwimSession(trajectory="nowhere")
 

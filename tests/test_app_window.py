@@ -177,7 +177,7 @@ def test_benchmark_frames_prints_fps_and_realtime_factor(display):
 
 
 @pytest.mark.parametrize("args, words", [
-    (("--stroke", "butterfly"), ("unknown stroke", "butterfly")),
+    (("--stroke", "dog_paddle"), ("unknown stroke", "dog_paddle")),
     (("--trajectory", "missing.yaml"), ("missing.yaml",)),
     (("--current", "1,2"), ("--current",)),
     (("--size", "big"), ("--size",)),

@@ -217,15 +217,24 @@ def test_short_follow_gets_closer_to_a_fixed_target():
     assert end < start - 2.5
 
 
-@pytest.mark.parametrize("stroke_name", ["breaststroke", "front_crawl", "treading_water"])
-def test_shipped_calibration_is_fresh_and_every_sequence_turns_monotonically(stroke_name):
-    """Yang Fig. 11: more weight, more turn, in every stroke, for every sequence and tempo."""
+@pytest.mark.parametrize("stroke_name, axes", [
+    ("breaststroke", ("yaw", "pitch", "roll")), ("front_crawl", ("yaw", "pitch", "roll")),
+    ("treading_water", ("yaw", "pitch", "roll")),
+    # Their pitch and roll sequences do not yet turn them monotonically at every tempo (README
+    # "Strokes"); their steering corrects the heading only.
+    ("backstroke", ("yaw",)), ("butterfly", ("yaw",))])
+def test_shipped_calibration_is_fresh_and_every_sequence_turns_monotonically(stroke_name, axes):
+    """Yang Fig. 11: more weight, more turn, for every sequence of the axes the stroke steers
+    with, at every tempo."""
     stroke = load_stroke(stroke_name, LAYOUT)
     shipped = load_table(stroke)                       # raises if missing or stale
     assert set(shipped.turn_rad) == set(stroke.perturbations) == set(
         ("pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right"))
+    assert stroke.steering.pitch_fraction == 0.0 or "pitch" in axes
+    assert stroke.steering.roll_fraction == 0.0 or "roll" in axes
     for name, rows in shipped.turn_rad.items():
-        assert np.all(np.diff(rows, axis=1) > 0), f"{stroke_name} {name}: {np.degrees(rows).round(2)}"
+        if name.split("_")[0] in axes:
+            assert np.all(np.diff(rows, axis=1) > 0), f"{stroke_name} {name}: {np.degrees(rows).round(2)}"
 
 
 def test_palm_rule_adds_forward_displacement():
@@ -255,10 +264,11 @@ def _straight_speed_m_s(stroke: str, layers: str, seconds: float = 8.0) -> float
         episode.close()
 
 
-def test_rules_only_add_thrust_in_the_crawl():
+@pytest.mark.parametrize("stroke", ["front_crawl", "backstroke", "butterfly"])
+def test_rules_only_add_thrust(stroke):
     """The rules push hardest toward a target far ahead: there they must not cost speed. (Slicing
     the palm from entry to catch once took the crawl from 1.34 to 0.05 m/s.)"""
-    assert _straight_speed_m_s("front_crawl", "basic,rules") >= _straight_speed_m_s("front_crawl", "basic")
+    assert _straight_speed_m_s(stroke, "basic,rules") >= _straight_speed_m_s(stroke, "basic")
 
 
 def test_rules_stay_out_when_no_more_thrust_is_wanted():

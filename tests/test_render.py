@@ -63,7 +63,7 @@ def test_render_mp4(tmp_path):
     (("nowhere", "--out", "x"), ("nowhere", "trajectory")),
     (("figure_eight", "--out", "x", "--fps", "0"), ("--fps",)),
     (("figure_eight", "--out", "x", "--size", "1x1"), ("--size",)),
-    (("figure_eight", "--out", "x", "--stroke", "butterfly"), ("butterfly",)),
+    (("figure_eight", "--out", "x", "--stroke", "dog_paddle"), ("dog_paddle",)),
 ])
 def test_render_bad_input(args, words, tmp_path):
     assert_one_line_error(cli("render", *args, cwd=tmp_path), *words)

@@ -24,15 +24,16 @@ QUANTITIES = {
 }
 
 DEFINITIONS = """\
-- **Cycles** start when the cycle marker rises through its mean: for prone strokes how far the
-  left hand is ahead of the pelvis along the body (the hand passing mid-reach as it recovers
+- **Cycles** start when the cycle marker rises through its mean: for prone and supine strokes
+  how far the left hand is ahead of the pelvis along the body (the hand passing mid-reach as it recovers
   forward), for upright ones the left foot's height along the body (mid-way up before the press).
   Every number is averaged over whole cycles after the settle time; +- is the SD across cycles.
 - **Forward** is the horizontal direction the centre of mass travelled. The **thrust axis** is
-  forward for prone strokes and straight up for upright ones (treading water holds the body up).
+  forward for prone and supine strokes and straight up for upright ones (treading water holds
+  the body up).
 - **Intracycle speed fluctuation**: half the range of the centre-of-mass forward speed within a
   cycle, as a percentage of that cycle's mean speed.
-- **Body pitch**: elevation of the pelvis long axis above the horizontal (prone: head up > 0),
+- **Body pitch**: elevation of the pelvis long axis above the horizontal (head up > 0),
   or for upright strokes of its front axis (leaning back > 0).
 - **Roll**: tilt of the thorax (shoulders) or pelvis (hips) lateral axis out of the horizontal;
   the amplitude is half its range within a cycle, i.e. the roll to each side.

@@ -3,8 +3,8 @@
 ``analyze_log`` cuts the settled part of a log into stroke cycles (``cycles.py``) and measures
 each cycle; the helpers above it each compute one quantity and are tested on hand-made
 trajectories. Axes: world z up, surface at z = 0. "Forward" is the horizontal direction the
-centre of mass travelled over the analysed window; the thrust axis is forward for prone strokes
-and straight up for upright ones (treading water pushes the body up, not along).
+centre of mass travelled over the analysed window; the thrust axis is forward for prone and supine
+strokes and straight up for upright ones (treading water pushes the body up, not along).
 """
 from __future__ import annotations
 
@@ -17,10 +17,11 @@ from layered_swim.tasks.metrics import roll_deg
 from layered_swim.config import ConfigError
 from layered_swim.geometry import quat_rotate
 from layered_swim.control.steering import FORWARD_LOCAL
+from layered_swim.state import lying
 
 PELVIS_LONG_AXIS_LOCAL = np.array([0.0, 0.0, 1.0])
 LIMBS = ("hand_l", "hand_r", "foot_l", "foot_r")
-CYCLE_MARKER = {"prone": "hand_l", "upright": "foot_l"}   # reaches furthest once per cycle
+CYCLE_MARKER = {"prone": "hand_l", "supine": "hand_l", "upright": "foot_l"}   # reaches furthest once per cycle
 MIN_CYCLES = 2
 EXCERPT_CYCLES = 6     # cycles shown as time series in the plot of how the swim was cut
 UP = np.array([0.0, 0.0, 1.0])
@@ -36,8 +37,8 @@ def travel_direction(com_pos_m) -> np.ndarray:
 
 
 def pitch_deg(quat_xyzw, forward_local) -> np.ndarray:
-    """Elevation of a segment's forward axis above the horizontal (head up > 0 for a prone
-    pelvis, leaning back > 0 for an upright one)."""
+    """Elevation of a segment's forward axis above the horizontal (head up > 0 for a prone or
+    supine pelvis, leaning back > 0 for an upright one)."""
     forward = quat_rotate(np.asarray(quat_xyzw, dtype=float), np.asarray(forward_local, dtype=float))
     return np.degrees(np.arcsin(np.clip(forward[..., 2], -1.0, 1.0)))
 
@@ -115,7 +116,7 @@ def analyze_log(log: dict, info: SwimmerInfo) -> dict:
         raise ConfigError(f"only {max(len(starts) - 1, 0)} whole stroke cycles after the {info.settle_s:g} s settle "
                           f"time (a cycle is one rise and fall of the {CYCLE_MARKER[info.posture]}'s reach along the "
                           f"body); at least {MIN_CYCLES} are needed: swim longer, or the stroke does not cycle")
-    prone = info.posture == "prone"
+    prone = lying(info.posture)
     forward = travel_direction(window["com_pos_m"])
     series = _series(window, seg, info.posture, forward, forward if prone else UP)
     profiles = {name: resample_cycles(t, values, starts) for name, values in series.items()}

@@ -1,7 +1,7 @@
 """Where the swimmer points and how far it must turn: the inputs of the per-cycle layer.
 
 All angles in radians. Heading is the yaw of the swimmer's forward axis (the pelvis long axis
-for prone strokes, its front for upright ones); pitch is that axis's elevation; roll is the tilt
+for prone and supine strokes, its front for upright ones); pitch is that axis's elevation; roll is the tilt
 of the shoulder line (thorax lateral axis) out of the horizontal, positive when the left shoulder
 is up. Pure functions of arrays.
 """
@@ -13,9 +13,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from layered_swim.geometry import quat_rotate
-from layered_swim.state import BodyState
+from layered_swim.state import BodyState, lying
 
-FORWARD_LOCAL = {"prone": np.array([0.0, 0.0, 1.0]), "upright": np.array([1.0, 0.0, 0.0])}
+FORWARD_LOCAL = {"prone": np.array([0.0, 0.0, 1.0]), "supine": np.array([0.0, 0.0, 1.0]),
+                 "upright": np.array([1.0, 0.0, 0.0])}
 LATERAL_LOCAL = np.array([0.0, 1.0, 0.0])
 
 
@@ -75,7 +76,7 @@ def wanted_turns(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,
     yaw_error = wrap_angle(math.atan2(delta[1], delta[0]) - att.heading_rad) if horizontal > 1e-6 else 0.0
     turns = {"yaw": gains.yaw_fraction * yaw_error, "pitch": 0.0,
              "roll": gains.roll_fraction * (att.roll_rad - level_roll_rad)}
-    if posture == "prone":
+    if lying(posture):
         glide = max(-gains.max_glide_pitch_rad, min(gains.max_glide_pitch_rad, math.atan2(delta[2], horizontal)))
         turns["pitch"] = gains.pitch_fraction * (glide - att.pitch_rad)
     return turns

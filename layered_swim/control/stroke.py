@@ -38,7 +38,7 @@ class JointKeys(Strict):
 
 
 class StartSpec(Strict):
-    posture: Literal["prone", "upright"] = "prone"
+    posture: Literal["prone", "supine", "upright"] = "prone"
     depth_m: float = Field(0.0, ge=-1.0, le=10.0)     # pelvis centre below the surface
     speed_m_s: float = Field(0.0, ge=0.0, le=3.0)
 

@@ -23,7 +23,9 @@ from layered_swim.sim.world import World
 from layered_swim.state import BodyState, JointLayout, Start
 
 PRONE_QUAT_XYZW = (0.0, math.sqrt(0.5), 0.0, math.sqrt(0.5))  # standing frame pitched 90 deg: head +x, face down
+SUPINE_QUAT_XYZW = (math.sqrt(0.5), 0.0, math.sqrt(0.5), 0.0)  # prone turned half about the long axis: face up
 UPRIGHT_QUAT_XYZW = (0.0, 0.0, 0.0, 1.0)
+BASE_QUAT_XYZW = {"prone": PRONE_QUAT_XYZW, "supine": SUPINE_QUAT_XYZW, "upright": UPRIGHT_QUAT_XYZW}
 MAX_SPEED_M_S = 50.0     # any segment faster than this means the integration blew up
 
 
@@ -92,7 +94,7 @@ class Simulation:
         return self.fluid_now.force_n
 
     def reset(self, start: Start) -> None:
-        base = PRONE_QUAT_XYZW if start.posture == "prone" else UPRIGHT_QUAT_XYZW
+        base = BASE_QUAT_XYZW[start.posture]
         heading = start.heading_rad
         yaw = (0.0, 0.0, math.sin(heading / 2), math.cos(heading / 2))
         quat = quat_multiply(np.array(yaw), np.array(base))
