@@ -65,9 +65,6 @@ class BodyState:
         return self.segments.centre_of_mass(self.linvel_m_s)
 
 
-POSTURES = ("prone", "supine", "upright")
-
-
 def lying(posture: str) -> bool:
     """Prone and supine strokes swim along the body's long axis; upright ones do not travel."""
     return posture != "upright"

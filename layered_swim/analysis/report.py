@@ -25,8 +25,8 @@ QUANTITIES = {
 
 DEFINITIONS = """\
 - **Cycles** start when the cycle marker rises through its mean: for prone and supine strokes
-  how far the left hand is ahead of the pelvis along the body (the hand passing mid-reach as it recovers
-  forward), for upright ones the left foot's height along the body (mid-way up before the press).
+  how far the left hand is ahead of the pelvis along the body (the hand passing mid-reach as it
+  recovers forward), for upright ones the left foot's height along the body (mid-way up before the press).
   Every number is averaged over whole cycles after the settle time; +- is the SD across cycles.
 - **Forward** is the horizontal direction the centre of mass travelled. The **thrust axis** is
   forward for prone and supine strokes and straight up for upright ones (treading water holds

@@ -1,9 +1,9 @@
 """Where the swimmer points and how far it must turn: the inputs of the per-cycle layer.
 
 All angles in radians. Heading is the yaw of the swimmer's forward axis (the pelvis long axis
-for prone and supine strokes, its front for upright ones); pitch is that axis's elevation; roll is the tilt
-of the shoulder line (thorax lateral axis) out of the horizontal, positive when the left shoulder
-is up. Pure functions of arrays.
+for prone and supine strokes, its front for upright ones); pitch is that axis's elevation; roll
+is the tilt of the shoulder line (thorax lateral axis) out of the horizontal, positive when the
+left shoulder is up. Pure functions of arrays.
 """
 from __future__ import annotations
 
