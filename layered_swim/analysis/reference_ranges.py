@@ -22,9 +22,16 @@ class Range:
 
 
 PEAK_HAND_FORCE = Range(70.0, 150.0, "peak hand force, typical studies (R)")
-# The sheet gives no recreational speed for backstroke or butterfly: a real swimmer's speed lies
-# between the slowest recreational speed it gives for any stroke and the stroke's world record.
-SLOWEST_RECREATIONAL_M_S = 0.6
+BREASTSTROKE_SPEED = Range(0.6, 1.0, "recreational breaststroke speed (R)")
+
+
+def up_to_record(record_m_s: float, stroke: str) -> Range:
+    """The sheet gives no recreational speed for backstroke or butterfly: a real swimmer's speed
+    lies between the slowest recreational speed it gives for any stroke (breaststroke's) and the
+    stroke's 100 m world record."""
+    return Range(BREASTSTROKE_SPEED.low, record_m_s, f"slowest recreational speed of any stroke "
+                 f"({BREASTSTROKE_SPEED.low:g}, breaststroke) to the 100 m {stroke} world record's mean")
+
 
 RANGES: dict[str, dict[str, Range]] = {
     "front_crawl": {
@@ -37,15 +44,14 @@ RANGES: dict[str, dict[str, Range]] = {
         "peak_hand_force_n": PEAK_HAND_FORCE,
     },
     "breaststroke": {
-        "mean_speed_m_s": Range(0.6, 1.0, "recreational breaststroke speed (R)"),
+        "mean_speed_m_s": BREASTSTROKE_SPEED,
         "stroke_rate_cpm": Range(50.0, 60.0, "elite breaststroke stroke rate (Hay 1984)"),
         "distance_per_cycle_m": Range(1.8, 2.0, "elite breaststroke distance per cycle (Hay 1984)"),
         "speed_fluctuation_pct": Range(45.0, 50.0, "breaststroke intracycle speed fluctuation +-45-50 % (Craig & Pendergast 1979)"),
         "peak_hand_force_n": PEAK_HAND_FORCE,
     },
     "backstroke": {
-        "mean_speed_m_s": Range(SLOWEST_RECREATIONAL_M_S, 1.94, "slowest recreational speed of any stroke (0.6, "
-                                "breaststroke) to the 100 m backstroke world record's mean"),
+        "mean_speed_m_s": up_to_record(1.94, "backstroke"),
         "stroke_rate_cpm": Range(45.0, 50.0, "elite backstroke stroke rate (Hay 1984)"),
         "distance_per_cycle_m": Range(2.2, 2.4, "elite backstroke distance per cycle (Hay 1984)"),
         "speed_fluctuation_pct": Range(15.0, 20.0, "backstroke intracycle speed fluctuation +-15-20 % (Craig & Pendergast 1979)"),
@@ -53,8 +59,7 @@ RANGES: dict[str, dict[str, Range]] = {
         "peak_hand_force_n": PEAK_HAND_FORCE,
     },
     "butterfly": {
-        "mean_speed_m_s": Range(SLOWEST_RECREATIONAL_M_S, 2.02, "slowest recreational speed of any stroke (0.6, "
-                                "breaststroke) to the 100 m butterfly world record's mean"),
+        "mean_speed_m_s": up_to_record(2.02, "butterfly"),
         "stroke_rate_cpm": Range(50.0, 55.0, "elite butterfly stroke rate (Hay 1984)"),
         "distance_per_cycle_m": Range(2.0, 2.1, "elite butterfly distance per cycle (Hay 1984)"),
         "speed_fluctuation_pct": Range(45.0, 50.0, "butterfly intracycle speed fluctuation +-45-50 % (Craig & Pendergast 1979)"),

@@ -90,7 +90,7 @@ def propelling_efficiency(drag_n, speed_m_s, power_w):
 @dataclass(frozen=True)
 class SwimmerInfo:
     segment_names: tuple[str, ...]
-    posture: str              # prone | upright: which segment marks cycles, which axis is thrust
+    posture: str              # prone | supine | upright: which segment marks cycles, which axis is thrust
     period_hint_s: float      # the controller's cycle period, to reject noise crossings
     settle_s: float           # analyse from here on
 
@@ -116,24 +116,24 @@ def analyze_log(log: dict, info: SwimmerInfo) -> dict:
         raise ConfigError(f"only {max(len(starts) - 1, 0)} whole stroke cycles after the {info.settle_s:g} s settle "
                           f"time (a cycle is one rise and fall of the {CYCLE_MARKER[info.posture]}'s reach along the "
                           f"body); at least {MIN_CYCLES} are needed: swim longer, or the stroke does not cycle")
-    prone = lying(info.posture)
+    travels = lying(info.posture)     # along the body; an upright stroke holds itself up
     forward = travel_direction(window["com_pos_m"])
-    series = _series(window, seg, info.posture, forward, forward if prone else UP)
+    series = _series(window, seg, info.posture, forward, forward if travels else UP)
     profiles = {name: resample_cycles(t, values, starts) for name, values in series.items()}
-    rows = _cycle_rows(t, window, starts, forward, profiles, prone)
+    rows = _cycle_rows(t, window, starts, forward, profiles, travels)
     summary = {name: _stats(values) for name, values in rows.items() if name != "start_s"}
     for limb in ("hand", "foot"):
         summary[f"peak_{limb}_force_n"] = _stats(np.maximum(rows[f"peak_{limb}_l_force_n"], rows[f"peak_{limb}_r_force_n"]))
     speed = summary["mean_speed_m_s"]["mean"]
-    drag = summary["resistive_force_n"]["mean"] if prone else None
+    drag = summary["resistive_force_n"]["mean"] if travels else None
     summary.update({
         "cycles": len(starts) - 1,
         "analysed_s": float(starts[-1] - starts[0]),
         "travel_direction": forward.tolist(),
-        "thrust_axis": "forward" if prone else "up",
+        "thrust_axis": "forward" if travels else "up",
         "active_drag_n": drag,
-        "active_drag_per_v2_kg_m": drag / speed**2 if prone else None,
-        "propelling_efficiency": propelling_efficiency(drag, speed, summary["mechanical_power_w"]["mean"]) if prone else None,
+        "active_drag_per_v2_kg_m": drag / speed**2 if travels else None,
+        "propelling_efficiency": propelling_efficiency(drag, speed, summary["mechanical_power_w"]["mean"]) if travels else None,
     })
     return {
         "summary": summary,
@@ -176,7 +176,7 @@ def _series(window: dict, seg: dict, posture: str, forward: np.ndarray, thrust_a
     return series
 
 
-def _cycle_rows(t, window: dict, starts, forward, profiles: dict, prone: bool) -> dict:
+def _cycle_rows(t, window: dict, starts, forward, profiles: dict, travels: bool) -> dict:
     """One value per cycle for every per-cycle quantity (arrays of length cycles)."""
     means = {name: cycle_means(p) for name, p in profiles.items()}
     duration = np.diff(starts)
@@ -192,7 +192,7 @@ def _cycle_rows(t, window: dict, starts, forward, profiles: dict, prone: bool) -
         "mechanical_power_w": mean_power_w(t, window["joint_work_j"], starts),
         **{f"peak_{name}_force_n": profiles[f"{name}_force_n"].max(axis=1) for name in LIMBS},
     }
-    if prone:    # an upright swimmer hardly travels: its speed fluctuation is noise over nothing
+    if travels:    # an upright swimmer hardly travels: its speed fluctuation is noise over nothing
         rows["speed_fluctuation_pct"] = speed_fluctuation_pct(profiles["forward_speed_m_s"])
     return rows
 

@@ -59,8 +59,8 @@ class FollowTarget(Task):
 
     def track(self) -> dict[str, np.ndarray]:
         """Per sample: ``track_time_s``, ``swimmer_m`` (centre of mass), ``target_m`` and ``pelvis_m``
-        (n, 3), ``heading_error_rad``
-        (the target's bearing off the heading), ``roll_rad`` (shoulder roll)."""
+        (n, 3), ``heading_error_rad`` (the target's bearing off the heading), ``roll_rad`` (shoulder
+        roll)."""
         return {name: np.array(rows) for name, rows in self._samples.items()}
 
     def metrics(self) -> dict:
