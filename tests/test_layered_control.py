@@ -15,7 +15,7 @@ from layered_swim.control.steering import Attitude, wanted_turns
 from layered_swim.control.stroke import (JointKeys, RulesSpec, StrokeSpec, build_stroke, load_stroke, mirrored_keys,
                                          stroke_path)
 from layered_swim.control.policy import Lead, TargetPolicy, TempoControl
-from layered_swim.control.targets import FixedTarget, load_trajectory
+from layered_swim.control.targets import FixedTarget, TrajectoryTarget, load_trajectory
 from layered_swim.episode import Episode
 from layered_swim.sim.simulation import PRONE_QUAT_XYZW
 from layered_swim.state import BodyState, Segments
@@ -305,6 +305,27 @@ def test_lead_looks_further_ahead_where_the_path_bends():
     assert lead.seconds(FixedTarget((3.0, 0.0, -0.3)), 0.0) == pytest.approx(1.5)
     assert lead.seconds(load_trajectory("straight_line"), 5.0) == pytest.approx(1.5)
     assert lead.seconds(load_trajectory("circle"), 5.0) > 2.0      # a circle keeps turning
+
+
+def test_lead_aims_from_the_swimmers_own_place_on_the_path_when_it_is_ahead():
+    line = load_trajectory("straight_line")          # x = 2 + 0.5 t, y = 0, 0.3 m deep
+    lead = Lead(straight_s=1.5, bend_s=3.0)
+    aim, ahead_s = lead.aim(line, 0.0, np.array([0.0, 0.5, -0.3]))      # behind: 1.5 s past the target
+    assert ahead_s == 0.0 and aim == pytest.approx([2.75, 0.0, -0.3])
+    aim, ahead_s = lead.aim(line, 0.0, np.array([4.0, 1.0, -0.3]))      # 2 m (4 s) ahead of it, off the line
+    assert ahead_s == pytest.approx(4.0) and aim == pytest.approx([4.75, 0.0, -0.3])
+
+
+def test_a_swimmer_ahead_of_its_target_waits_for_it():
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
+    behind = TrajectoryTarget(np.array([[-2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 22.0]), 0.5, False)
+    waiting = TargetPolicy(behind, table(), "prone")(0, state, 0.0)
+    assert not waiting.glide and waiting.thrust_demand == 0.0 and waiting.tempo == pytest.approx(TempoControl().min_tempo)
+    gliding = TargetPolicy(behind, table(), "prone", tempo=TempoControl(glide_within_m=0.6))(0, state, 0.0)
+    assert gliding.glide       # a stroke that glides to wait (the crawl) glides
+    ahead = TrajectoryTarget(np.array([[2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 18.0]), 0.5, False)
+    chasing = TargetPolicy(ahead, table(), "prone")(0, state, 0.0)
+    assert not chasing.glide and chasing.thrust_demand == pytest.approx(1.0)
 
 
 def test_policy_asks_for_thrust_only_when_far_and_ahead():

@@ -52,6 +52,23 @@ class Lead:
     straight_s: float = 1.5
     bend_s: float = 3.0
     full_bend_rad: float = math.radians(60.0)   # the path's change of direction over bend_s that earns all of it
+    search_s: float = 6.0       # how far along the path, either way from the target, to look for the swimmer
+    wait_ahead_s: float = 0.5   # ahead of the target by more than this along its path: slow down
+
+    def place_on_path_s(self, target: Target, time_s: float, position_m: np.ndarray) -> float:
+        """When the target passes (or passed) nearest the swimmer, within ``search_s`` of now:
+        where along the path the swimmer is, in the target's time."""
+        times_s = time_s + np.linspace(-self.search_s, self.search_s, 121)
+        gaps_m = [math.hypot(*(target.position(t) - position_m)[:2]) for t in times_s]
+        return float(times_s[int(np.argmin(gaps_m))])
+
+    def aim(self, target: Target, time_s: float, position_m: np.ndarray) -> tuple[np.ndarray, float]:
+        """The point to steer for and how many seconds the swimmer is ahead of the target along
+        its path. Behind, it aims ahead of the target; ahead (it cut a corner or a current carried
+        it), it aims ahead of its own place on the path, not back at the target: swimming back
+        to a target that comes toward it only circles it."""
+        place_s = max(time_s, self.place_on_path_s(target, time_s, position_m))
+        return target.position(place_s + self.seconds(target, place_s)), place_s - time_s
 
     def seconds(self, target: Target, time_s: float) -> float:
         now = target.position(time_s + 0.5) - target.position(time_s)
@@ -70,20 +87,27 @@ class TargetPolicy:
 
     def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
         position = state.com_m
-        # Aim where the target will be only where its path is known ahead (not a mouse or a jump).
-        ahead_s = self.lead.seconds(self.target, state.time_s) if getattr(self.target, "foresight", True) else 0.0
-        target = self.target.position(state.time_s + ahead_s)
+        # Aim ahead along the target's path only where it is known (not a mouse or a jump).
+        if getattr(self.target, "foresight", True):
+            target, ahead_of_target_s = self.lead.aim(self.target, state.time_s, position)
+        else:
+            target, ahead_of_target_s = self.target.position(state.time_s), 0.0
         now = attitude_of(state, self.posture)
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); roll
         # averaged over the last cycle (a crawl rolls +-30 deg within it).
         att = Attitude(now.heading_rad, now.pitch_rad, now.roll_rad if mean_roll_rad is None else mean_roll_rad)
         heading_error = bearing_error(position, target, att.heading_rad)
         distance = float(np.linalg.norm(self.target.position(state.time_s) - position))
-        drive = self.tempo_control.drive(distance, heading_error)
+        # Ahead of the target along its path: wait for it at the slowest tempo (turning at full tempo
+        # instead carried the breaststroke further out of the figure-eight), gliding where the stroke
+        # glides to wait (gliding, the breaststroke's depth drifted 0.27 m off a diving target's).
+        waiting = ahead_of_target_s > self.lead.wait_ahead_s
+        drive = 0.0 if waiting else self.tempo_control.drive(distance, heading_error)
         tempo = self.tempo_control.tempo_for(drive)
         self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains,
                                         self.table.pace.roll_at(tempo))
-        glide = distance < self.tempo_control.glide_within_m and abs(heading_error) < self.tempo_control.easy_turn_rad
+        glide = ((distance < self.tempo_control.glide_within_m or (waiting and self.tempo_control.glide_within_m > 0))
+                 and abs(heading_error) < self.tempo_control.easy_turn_rad)
         # Near the target, or turning hard, the rules stop seeking more thrust (Yang 4.4: more force
         # only where more is wanted); else they speed the swimmer past a slow target.
         return CycleChoice({} if glide else self.table.weights_for(self.last_wanted, tempo), tempo, glide,
