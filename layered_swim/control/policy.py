@@ -57,9 +57,10 @@ class Lead:
 
     def place_on_path_s(self, target: Target, time_s: float, position_m: np.ndarray) -> float:
         """When the target passes (or passed) nearest the swimmer, within ``search_s`` of now:
-        where along the path the swimmer is, in the target's time."""
+        where along the path the swimmer is, in the target's time. Nearest in 3-D: a swimmer over
+        a diving path, not yet down, is not ahead on it."""
         times_s = time_s + np.linspace(-self.search_s, self.search_s, 121)
-        gaps_m = [math.hypot(*(target.position(t) - position_m)[:2]) for t in times_s]
+        gaps_m = [float(np.linalg.norm(target.position(t) - position_m)) for t in times_s]
         return float(times_s[int(np.argmin(gaps_m))])
 
     def aim(self, target: Target, time_s: float, position_m: np.ndarray) -> tuple[np.ndarray, float]:
