@@ -314,6 +314,10 @@ def test_lead_aims_from_the_swimmers_own_place_on_the_path_when_it_is_ahead():
     assert ahead_s == 0.0 and aim == pytest.approx([2.75, 0.0, -0.3])
     aim, ahead_s = lead.aim(line, 0.0, np.array([4.0, 1.0, -0.3]))      # 2 m (4 s) ahead of it, off the line
     assert ahead_s == pytest.approx(4.0) and aim == pytest.approx([4.75, 0.0, -0.3])
+    # A steep dive (x = 0.25 t, z = -0.3 - 0.5 t): 0.5 m along it, still at the surface, the swimmer
+    # is over where the target will be in 2 s, but nearest (in 3-D) to where it is in 0.4 s.
+    dive = TrajectoryTarget(np.array([[0.0, 0.0, -0.3], [2.0, 0.0, -4.3]]), np.array([0.0, 8.0]), 1.0, False)
+    assert lead.aim(dive, 0.0, np.array([0.5, 0.0, -0.3]))[1] == pytest.approx(0.4)
 
 
 def test_a_swimmer_ahead_of_its_target_waits_for_it():
