@@ -82,7 +82,9 @@ class Episode:
         layout = joint_layout(self.body)
         paths = {name: stroke_path(name) for name in (AUTO_STROKES if stroke == AUTO else (stroke,))}
         specs = {name: load(StrokeSpec, path) for name, path in paths.items()}    # as validated, for config.json
-        strokes = {name: build_stroke(specs[name], layout, str(path)) for name, path in paths.items()}
+        # Each stroke trimmed for this water (nothing changes near the body's own density).
+        strokes = {name: build_stroke(specs[name], layout, str(path)).trimmed(self.body.density_ratio(medium.rho_kg_m3))
+                   for name, path in paths.items()}
         # The start and the config are the first stroke's (the one ``auto`` starts with).
         first = next(iter(paths))
         self.stroke_spec: StrokeSpec = specs[first]

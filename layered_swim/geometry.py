@@ -29,6 +29,11 @@ def quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     return v + w * t + np.cross(u, t)
 
 
+def ease(progress: float) -> float:
+    """0 to 1 as ``progress`` goes 0 to 1, flat at both ends (smoothstep): a blend with no kink."""
+    return progress * progress * (3.0 - 2.0 * progress)
+
+
 def unit_vector(v: np.ndarray) -> np.ndarray:
     """``v`` scaled to length 1 (zero stays zero)."""
     norm = float(np.linalg.norm(v))

@@ -116,9 +116,15 @@ def test_session_switches_apply_to_the_running_simulation(session):
     session.toggle_layer("palm")
     session.next_current()
     assert session.sim.fluid.medium.current_m_s == (0.0, 0.3, 0.0)
+    sim = session.sim
     session.next_density()
     assert session.sim.fluid.medium.rho_kg_m3 == pytest.approx(1023.3)
     assert session.sim.fluid.medium == session._medium()
+    assert session.sim is sim                     # seawater: the same stroke, no trim
+    session.next_density()                        # light fluid: the breaststroke is rebuilt, trimmed
+    assert session.sim is not sim and "trimmed" in session.message
+    assert session.sim.fluid.medium.rho_kg_m3 == pytest.approx(800.0) and session.sim.fluid.medium == session._medium()
+    assert session.sim.controller.layers.cycle and session.sim.fluid.medium.current_m_s == (0.0, 0.3, 0.0)
     session.current_index = session.density_index = 0
     session.step(480)
     where = session.com_m

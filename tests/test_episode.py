@@ -75,3 +75,19 @@ def test_scripted_weights_with_the_rules_on_swim_straight_ahead():
         assert np.abs(episode.controller.rule_offsets).max() > 0.0
     finally:
         episode.close()
+
+
+@pytest.mark.parametrize("rho_kg_m3, hip_deg", [(997.05, 0.0), (1023.3, 0.0), (900.0, 20.0), (2500.0, 20.0)])
+def test_the_breaststroke_is_trimmed_only_in_water_far_from_the_body_density(rho_kg_m3, hip_deg):
+    from layered_swim.runs import make_medium
+
+    fresh, other = Episode("breaststroke"), Episode("breaststroke", medium=make_medium(density_kg_m3=rho_kg_m3))
+    try:
+        names = other.sim.layout.names
+        moved = np.degrees(other.stroke.pose(0.4)[0] - fresh.stroke.pose(0.4)[0])
+        expected = np.zeros(len(names))
+        expected[[names.index("hip_l.flexion"), names.index("hip_r.flexion")]] = hip_deg
+        np.testing.assert_allclose(moved, expected, atol=1e-9)
+    finally:
+        fresh.close()
+        other.close()

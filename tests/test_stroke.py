@@ -84,6 +84,9 @@ def test_shipped_strokes_load(name):
     (GOOD.replace("flexion: {0.0: 0, 0.5: 145}", "flexion: {0.0: 0, 0.5: 145"), ["line"]),
     (GOOD + "steering: {glide_moving_joints: [hip_l, tail]}\n", ["steering.glide_moving_joints", "tail"]),
     (GOOD + "steering: {yaw_fraction: 1.5}\n", ["steering.yaw_fraction"]),
+    (GOOD + "trim: {joints: {elbow_l: {flexion: 10}}}\n", ["trim.joints", "elbow_l.flexion", "range"]),
+    (GOOD + "trim: {joints: {tail: {flexion: 10}}}\n", ["trim.joints.tail", "unknown joint"]),
+    (GOOD + "trim: {light_from: 0.9, light_full: 0.95}\n", ["trim", "light_full < light_from"]),
 ])
 def test_bad_stroke_file(tmp_path, text, words):
     path = write(tmp_path, text, "bad.yaml")
@@ -92,3 +95,37 @@ def test_bad_stroke_file(tmp_path, text, words):
     message = str(err.value)
     assert "\n" not in message
     assert str(path) in message and all(word in message for word in words), message
+
+
+TRIMMED = GOOD + textwrap.dedent("""\
+    trim:
+      joints: {hip_l: {flexion: 20}}
+      light_from: 0.95
+      light_full: 0.9
+      dense_from: 2.0
+      dense_full: 3.0
+""")
+
+
+def test_trim_weight_is_nothing_near_the_body_density_and_all_far_from_it(tmp_path):
+    trim = load_stroke(str(write(tmp_path, TRIMMED)), LAYOUT).trim_spec
+    assert [trim.weight(r) for r in (0.95, 1.0, 1.5, 2.0)] == [0.0, 0.0, 0.0, 0.0]
+    assert trim.weight(0.9) == trim.weight(0.5) == trim.weight(3.0) == trim.weight(8.0) == 1.0
+    assert trim.weight(0.925) == pytest.approx(0.5) and trim.weight(2.5) == pytest.approx(0.5)  # smoothstep's middle
+    assert trim.weight(2.25) == pytest.approx(0.25 ** 2 * (3 - 0.5))
+
+
+def test_a_trimmed_stroke_moves_its_key_poses_by_the_trim(tmp_path):
+    stroke = load_stroke(str(write(tmp_path, TRIMMED)), LAYOUT)
+    assert stroke.trimmed(1.2) is stroke
+    hip = LAYOUT.names.index("hip_l.flexion")
+    heavy = stroke.trimmed(3.0)
+    for phase in (0.0, 0.3, 0.77):
+        pose, rate = stroke.pose(phase)
+        moved, moved_rate = heavy.pose(phase)
+        offset = np.zeros(LAYOUT.size)
+        offset[hip] = np.radians(20.0)
+        np.testing.assert_allclose(moved - pose, offset, atol=1e-12)
+        np.testing.assert_array_equal(moved_rate, rate)
+    half = stroke.trimmed(2.5).pose(0.3)[0] - stroke.pose(0.3)[0]
+    assert half[hip] == pytest.approx(np.radians(10.0))

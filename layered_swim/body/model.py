@@ -183,6 +183,10 @@ class Body:
     def total_volume_m3(self) -> float:
         return float(self.volume_m3.sum())
 
+    def density_ratio(self, rho_kg_m3: float) -> float:
+        """The water's density over the body's (as it holds its breath now): above 1 it floats."""
+        return rho_kg_m3 * self.total_volume_m3 / self.total_mass_kg
+
     def index(self, segment: str) -> int:
         return self.segment_names.index(segment)
 

@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from layered_swim.control.layered import LayeredController, ease
+from layered_swim.control.layered import LayeredController
+from layered_swim.geometry import ease
 from layered_swim.control.steering import attitude_of, bearing_error
 from layered_swim.control.targets import Target
 from layered_swim.state import BodyState

@@ -20,16 +20,11 @@ from layered_swim.control.rules import ArmIndices, rule_offsets
 from layered_swim.control.steering import forward_axis, shoulder_roll
 from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
 from layered_swim.control.targets import Target
-from layered_swim.geometry import unit_vector
+from layered_swim.geometry import ease, unit_vector
 from layered_swim.state import BodyState, JointLayout
 
 
 BLEND_CYCLES = 0.15   # a new cycle's weights take over within this fraction of it
-
-
-def ease(progress: float) -> float:
-    """0 to 1 as ``progress`` goes 0 to 1, flat at both ends (smoothstep): a blend with no kink."""
-    return progress * progress * (3.0 - 2.0 * progress)
 
 
 @dataclass(frozen=True)

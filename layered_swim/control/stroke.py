@@ -10,16 +10,17 @@ from __future__ import annotations
 
 import hashlib
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, model_validator
 from scipy.interpolate import PchipInterpolator
 
 from layered_swim.config import ConfigError, Degrees, Strict, available_files, between, file_path, load
 from layered_swim.control.steering import SteeringGains
+from layered_swim.geometry import ease
 from layered_swim.state import JointLayout, Start
 
 STROKES_DIR = Path(__file__).resolve().parents[2] / "strokes"
@@ -91,6 +92,34 @@ class SteeringSpec(Strict):
     breathe: bool = False           # breathe out to sink and in to rise toward the target's depth
 
 
+class TrimSpec(Strict):
+    """A posture for water far from the body's own density (``density_ratio``: the water's over the
+    body's at its resting breath), added to every key pose: nothing in water near the body's
+    density, all of ``joints`` at or beyond ``light_full`` / ``dense_full``, eased in between."""
+
+    joints: dict[str, dict[str, Degrees]] = {}
+    light_from: float = Field(0.97, gt=0.0, le=1.0)
+    light_full: float = Field(0.93, gt=0.0, le=1.0)
+    dense_from: float = Field(1.6, ge=1.0, le=10.0)
+    dense_full: float = Field(2.4, ge=1.0, le=10.0)
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if not (self.light_full < self.light_from and self.dense_from < self.dense_full):
+            raise ValueError("expected light_full < light_from and dense_from < dense_full")
+        return self
+
+    def weight(self, density_ratio: float) -> float:
+        """How much of the trim to use, 0 to 1."""
+        if density_ratio < self.light_from:
+            share = (self.light_from - density_ratio) / (self.light_from - self.light_full)
+        elif density_ratio > self.dense_from:
+            share = (density_ratio - self.dense_from) / (self.dense_full - self.dense_from)
+        else:
+            return 0.0
+        return ease(min(1.0, share))
+
+
 class StrokeSpec(Strict):
     name: str
     description: str = ""
@@ -103,6 +132,7 @@ class StrokeSpec(Strict):
     perturbations: dict[Sequence, PerturbationSpec] = {}
     rules: RulesSpec = RulesSpec()
     steering: SteeringSpec = SteeringSpec()
+    trim: TrimSpec = TrimSpec()
 
 
 @dataclass(frozen=True)
@@ -134,6 +164,16 @@ class Stroke:
     pd_gain_scale: dict[str, float]
     source: str
     spec_sha256: str                         # of the parsed file less its steering: calibration tables check it
+    trim_spec: TrimSpec = TrimSpec()
+    trim_rad: np.ndarray | None = None       # (n,) the full trim's offsets
+
+    def trimmed(self, density_ratio: float) -> "Stroke":
+        """This stroke for water ``density_ratio`` times the body's density: its key poses moved by
+        the share of the trim that water asks for (none near the body's own density)."""
+        weight = self.trim_spec.weight(density_ratio)
+        if weight == 0.0 or self.trim_rad is None:
+            return self
+        return replace(self, basic=CyclicTable(self.basic.values + weight * self.trim_rad, self.basic.rates))
 
     @property
     def table(self) -> np.ndarray:
@@ -251,12 +291,21 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
         if joint not in joints:
             raise ConfigError(f"{source}: field 'steering.glide_moving_joints': unknown joint '{joint}'")
     glide_moving = np.array([name.split(".")[0] in spec.steering.glide_moving_joints for name in layout.names])
+    trim = np.zeros(layout.size)
+    for joint, axes in spec.trim.joints.items():
+        for axis, deg in axes.items():
+            trim[_coord(layout, joints, joint, axis, f"{source}: field 'trim.joints.{joint}.{axis}'")] = np.radians(deg)
+    trimmed = basic.values + trim
+    outside = (trimmed < layout.lower_rad - 1e-9) | (trimmed > layout.upper_rad + 1e-9)
+    if outside.any():
+        k = int(np.argwhere(outside.any(axis=0))[0, 0])
+        raise ConfigError(f"{source}: field 'trim.joints': {layout.names[k]} with its trim leaves the range of motion")
     # What calibration measures: it swims without the rules, and the steering settings only read
-    # its table, so both stay out.
-    digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude={"steering", "rules"}),
+    # its table, so both stay out; so does the trim, nothing in the water calibration swims in.
+    digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude={"steering", "rules", "trim"}),
                                        sort_keys=True).encode()).hexdigest()
     return Stroke(spec.name, spec.description, spec.period_s, spec.start, basic, perturbations, spec.rules,
-                  spec.steering, glide_moving, dict(spec.pd_gain_scale), source, digest)
+                  spec.steering, glide_moving, dict(spec.pd_gain_scale), source, digest, spec.trim, trim)
 
 
 def _coord(layout: JointLayout, joints: set[str], joint: str, axis: str, where: str) -> int:

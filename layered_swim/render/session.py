@@ -193,8 +193,17 @@ class SwimSession:
         self.sim.fluid.set_medium(self._medium())
 
     def next_density(self) -> None:
+        trim = self._trim_weight()
         self.density_index = (self.density_index + 1) % len(self.densities)
-        self.sim.fluid.set_medium(self._medium())
+        if self._trim_weight() != trim:
+            self.set_stroke(self.stroke)      # strokes are trimmed for the water they are built in
+            self.message = f"{self.stroke} trimmed for {self.densities[self.density_index].label}"
+        else:
+            self.sim.fluid.set_medium(self._medium())
+
+    def _trim_weight(self) -> float:
+        stroke = self.episode.stroke
+        return stroke.trim_spec.weight(self.episode.body.density_ratio(self._medium().rho_kg_m3))
 
     def set_target(self, point_xy_m) -> None:
         """Put the mouse target at a point on the water, at the current target depth."""
