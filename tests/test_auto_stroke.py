@@ -22,7 +22,7 @@ AHEAD, BEHIND = 0.0, math.radians(150.0)
     (TURN, 1.5, 0.0, AHEAD, TURN),        # ...but does not start until within hold_within_m
     (HOLD, 2.5, 0.0, AHEAD, TURN),
     (HOLD, 1.5, 0.5, AHEAD, TURN),        # or until it moves
-    (TURN, 8.0, 0.5, AHEAD, SPRINT),      # far ahead: sprint
+    (TURN, 13.0, 0.5, AHEAD, SPRINT),     # far ahead: sprint
     (TURN, 8.0, 0.5, BEHIND, TURN),       # far behind: turn first
     (SPRINT, 4.0, 0.5, math.radians(45.0), SPRINT),   # a sprint keeps on to sprint_until_m...
     (TURN, 4.0, 0.5, AHEAD, TURN),        # ...which a turn does not start from
@@ -62,3 +62,21 @@ def test_auto_holds_a_still_target_by_treading_water_and_never_jumps_the_pose():
 def test_auto_needs_a_target():
     with pytest.raises(ConfigError, match="auto"):
         Episode("auto")
+
+
+def test_auto_starts_holding_a_still_target_as_soon_as_it_is_in_reach():
+    """Not at the next cycle end: a breaststroke turning tightly round the target may be in reach
+    only between its cycle ends."""
+    episode = Episode("auto", FollowTarget(FixedTarget([2.5, 0.0, -0.3])))
+    try:
+        switched = []
+        episode.run(8.0, observers=[lambda sim: switched or not episode.controller.switches or switched.append(
+            (sim.time_s, episode.controller.controllers[TURN].cycle_start_s, episode.controller.controllers[TURN].cycles_per_s,
+             float(np.linalg.norm(sim.state.com_m - [2.5, 0.0, -0.3]))))])
+        controller = episode.controller
+    finally:
+        episode.close()
+    assert controller.switches[0][1] == HOLD
+    time_s, cycle_start_s, cycles_per_s, distance_m = switched[0]
+    assert (time_s - cycle_start_s) * cycles_per_s < 0.95      # mid-cycle
+    assert distance_m < RULE.hold_within_m + 0.05

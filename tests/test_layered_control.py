@@ -6,6 +6,7 @@ import pytest
 
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, load
+from layered_swim.analysis.calibrate import _measure
 from layered_swim.control.calibration import CalibrationTable, Pace, load_table
 from layered_swim.control.layered import CycleChoice, Layers, LayeredController, fixed_weights
 from layered_swim.body.layout import joint_layout
@@ -340,3 +341,11 @@ def test_policy_asks_for_thrust_only_when_far_and_ahead():
     assert choice((-5.0, 0.0, 0.0)).thrust_demand == pytest.approx(0.0)    # behind: turn first
     near = choice((0.1, 0.0, 0.0))
     assert near.tempo == pytest.approx(TempoControl().min_tempo)
+
+
+def test_the_breaststroke_turns_inside_the_figure_eights_tightest_bend():
+    """Its full yaw sequence at tempo 0.7 turns on a circle smaller than the 1.25 m radius at the
+    tops of figure_eight's lobes (the earlier sequence needed ~2 m and cut them)."""
+    turn_rad_per_cycle, speed_m_s, *_ = _measure(("breaststroke", "yaw_left", 1.0, 0.7))
+    turn_rad_s = turn_rad_per_cycle * 0.7 / load_stroke("breaststroke", LAYOUT).period_s
+    assert turn_rad_s > 0 and speed_m_s / turn_rad_s < 1.25
