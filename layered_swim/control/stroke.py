@@ -164,14 +164,14 @@ class Stroke:
     pd_gain_scale: dict[str, float]
     source: str
     spec_sha256: str                         # of the parsed file less its steering: calibration tables check it
-    trim_spec: TrimSpec = TrimSpec()
-    trim_rad: np.ndarray | None = None       # (n,) the full trim's offsets
+    trim_spec: TrimSpec
+    trim_rad: np.ndarray                     # (n,) the full trim's offsets
 
     def trimmed(self, density_ratio: float) -> "Stroke":
         """This stroke for water ``density_ratio`` times the body's density: its key poses moved by
         the share of the trim that water asks for (none near the body's own density)."""
         weight = self.trim_spec.weight(density_ratio)
-        if weight == 0.0 or self.trim_rad is None:
+        if weight == 0.0:
             return self
         return replace(self, basic=CyclicTable(self.basic.values + weight * self.trim_rad, self.basic.rates))
 
@@ -259,6 +259,13 @@ def mirrored_keys(keys: dict[str, JointKeys], phase_shift: float = 0.0) -> dict[
     return out
 
 
+def _first_out_of_range(poses_rad: np.ndarray, layout: JointLayout) -> int | None:
+    """The first pose coordinate that leaves its range of motion anywhere in ``poses_rad``
+    (rows: poses), or None."""
+    outside = ((poses_rad < layout.lower_rad - 1e-9) | (poses_rad > layout.upper_rad + 1e-9)).any(axis=0)
+    return int(np.argmax(outside)) if outside.any() else None
+
+
 def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
     joints = {name.split(".")[0] for name in layout.names}
     rest = np.zeros(layout.size)
@@ -267,9 +274,8 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
             rest[_coord(layout, joints, joint, axis, f"{source}: field 'rest_pose.{joint}.{axis}'")] = np.radians(deg)
     smooth = spec.interpolation == "smooth"
     basic = _keyed_table(spec.keys, rest, layout, joints, smooth, f"{source}: field 'keys")
-    outside = (basic.values < layout.lower_rad - 1e-9) | (basic.values > layout.upper_rad + 1e-9)
-    if outside.any():
-        k = int(np.argwhere(outside.any(axis=0))[0, 0])
+    k = _first_out_of_range(basic.values, layout)
+    if k is not None:
         lo, hi = np.degrees(layout.lower_rad[k]), np.degrees(layout.upper_rad[k])
         raise ConfigError(f"{source}: field 'keys.{layout.names[k]}': angles leave the range of motion "
                           f"[{lo:.0f}, {hi:.0f}] deg")
@@ -295,10 +301,8 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
     for joint, axes in spec.trim.joints.items():
         for axis, deg in axes.items():
             trim[_coord(layout, joints, joint, axis, f"{source}: field 'trim.joints.{joint}.{axis}'")] = np.radians(deg)
-    trimmed = basic.values + trim
-    outside = (trimmed < layout.lower_rad - 1e-9) | (trimmed > layout.upper_rad + 1e-9)
-    if outside.any():
-        k = int(np.argwhere(outside.any(axis=0))[0, 0])
+    k = _first_out_of_range(basic.values + trim, layout)
+    if k is not None:
         raise ConfigError(f"{source}: field 'trim.joints': {layout.names[k]} with its trim leaves the range of motion")
     # What calibration measures: it swims without the rules, and the steering settings only read
     # its table, so both stay out; so does the trim, nothing in the water calibration swims in.
