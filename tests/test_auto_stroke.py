@@ -80,3 +80,23 @@ def test_auto_starts_holding_a_still_target_as_soon_as_it_is_in_reach():
     time_s, cycle_start_s, cycles_per_s, distance_m = switched[0]
     assert (time_s - cycle_start_s) * cycles_per_s < 0.95      # mid-cycle
     assert distance_m < RULE.hold_within_m + 0.05
+
+
+def test_auto_leaves_a_held_target_the_moment_it_jumps_away():
+    """Not at the treading cycle's end: every second standing there is a second later at the jump."""
+    jump = StationTarget(np.array([[2.5, 0.0, -0.3], [2.5, 8.0, -0.3]]), np.array([0.0, 9.0]))
+    episode = Episode("auto", FollowTarget(jump))
+    seen = []
+    try:
+        episode.run(10.0, observers=[lambda sim: seen.append(
+            (sim.time_s, len(episode.controller.switches), episode.controller.controllers[HOLD].cycle_start_s,
+             episode.controller.controllers[HOLD].cycles_per_s))])
+        switches = episode.controller.switches
+    finally:
+        episode.close()
+    held = [t for t, name in switches if name == HOLD]
+    assert held and held[0] < 9.0 and switches[-1][1] == TURN
+    left_s = switches[-1][0]
+    assert 9.0 <= left_s < 9.05
+    _, _, cycle_start_s, cycles_per_s = next(row for row in seen if row[0] >= left_s - 1e-9)
+    assert (left_s - cycle_start_s) * cycles_per_s < 0.95      # mid-cycle

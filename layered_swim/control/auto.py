@@ -14,7 +14,8 @@ of every cycle of the stroke swimming now, ``StrokeChoice`` looks at the target:
 - **otherwise** breaststroke: the tighter turn and the slower pace, for bends and approaches.
 
 Holding starts at once, mid-cycle, when a still target comes within reach (a stroke circling it
-tightly may be in reach only between its cycle ends). The new stroke starts a fresh cycle at
+tightly may be in reach only between its cycle ends), and ends at once when the held target
+jumps away. The new stroke starts a fresh cycle at
 the switch, and the pose eases from the old stroke's to the new one's over ``blend_s``, so the
 joints never jump.
 """
@@ -115,7 +116,7 @@ class AutoStrokeController:
 
     def desired(self, time_s: float, state: BodyState | None,
                 flow_m_s: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-        if state is not None and (self.current.cycle_ends(time_s) or self._hold_now(state)):
+        if state is not None and (self.current.cycle_ends(time_s) or self._hold_changes_now(state)):
             wanted = self._wanted(state)
             if wanted != self.active:
                 self._switch(wanted, time_s)
@@ -140,13 +141,18 @@ class AutoStrokeController:
                                        target_speed_m_s(self.target, state.time_s),
                                        bearing_error(position, goal, heading))
 
-    def _hold_now(self, state: BodyState) -> bool:
-        """A still target come within reach mid-cycle is held at once: a stroke turning tightly
-        round it may pass within ``hold_within_m`` only between its cycle ends."""
-        if self.active == HOLD or self._from_pose is not None:
+    def _hold_changes_now(self, state: BodyState) -> bool:
+        """Whether holding should start or end now, mid-cycle: a still target come within reach is
+        held at once (a stroke turning tightly round it may pass within ``hold_within_m`` only
+        between its cycle ends), and a held target that jumps away is left at once."""
+        if self._from_pose is not None:
             return False
-        near = float(np.linalg.norm(self.target.position(state.time_s) - state.com_m)) < self.choice_rule.hold_within_m
-        return near and target_speed_m_s(self.target, state.time_s) < self.choice_rule.still_m_s
+        rule = self.choice_rule
+        distance_m = float(np.linalg.norm(self.target.position(state.time_s) - state.com_m))
+        still = target_speed_m_s(self.target, state.time_s) < rule.still_m_s
+        if self.active == HOLD:
+            return not still or distance_m >= rule.hold_leave_m
+        return still and distance_m < rule.hold_within_m
 
     def _switch(self, name: str, time_s: float) -> None:
         self._from_pose = None if self._last_pose is None else self._last_pose.copy()
