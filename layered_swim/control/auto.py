@@ -15,9 +15,8 @@ of every cycle of the stroke swimming now, ``StrokeChoice`` looks at the target:
 
 Holding starts at once, mid-cycle, when a still target comes within reach (a stroke circling it
 tightly may be in reach only between its cycle ends), and ends at once when the held target
-jumps away. The new stroke starts a fresh cycle at
-the switch, and the pose eases from the old stroke's to the new one's over ``blend_s``, so the
-joints never jump.
+jumps away. The new stroke starts a fresh cycle at the switch, and the pose eases from the old
+stroke's to the new one's over ``blend_s``, so the joints never jump.
 """
 from __future__ import annotations
 
@@ -48,9 +47,13 @@ class StrokeChoice:
     sprint_keep_rad: float = math.radians(60.0)
     blend_s: float = 0.5
 
+    def holds(self, active: str, distance_m: float, target_speed_m_s: float) -> bool:
+        """Whether to tread water at (or keep holding) the target: it stays put and is near."""
+        return target_speed_m_s < self.still_m_s and distance_m < (
+            self.hold_leave_m if active == HOLD else self.hold_within_m)
+
     def choose(self, active: str, distance_m: float, target_speed_m_s: float, heading_error_rad: float) -> str:
-        still = target_speed_m_s < self.still_m_s
-        if still and distance_m < (self.hold_leave_m if active == HOLD else self.hold_within_m):
+        if self.holds(active, distance_m, target_speed_m_s):
             return HOLD
         error = abs(heading_error_rad)
         if (distance_m > self.sprint_beyond_m and error < self.sprint_ahead_rad) or (
@@ -147,12 +150,9 @@ class AutoStrokeController:
         between its cycle ends), and a held target that jumps away is left at once."""
         if self._from_pose is not None:
             return False
-        rule = self.choice_rule
         distance_m = float(np.linalg.norm(self.target.position(state.time_s) - state.com_m))
-        still = target_speed_m_s(self.target, state.time_s) < rule.still_m_s
-        if self.active == HOLD:
-            return not still or distance_m >= rule.hold_leave_m
-        return still and distance_m < rule.hold_within_m
+        holds = self.choice_rule.holds(self.active, distance_m, target_speed_m_s(self.target, state.time_s))
+        return holds != (self.active == HOLD)
 
     def _switch(self, name: str, time_s: float) -> None:
         self._from_pose = None if self._last_pose is None else self._last_pose.copy()
