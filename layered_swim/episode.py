@@ -42,12 +42,12 @@ from layered_swim.control.lungs import LungControl
 from layered_swim.control.policy import TargetPolicy, TempoControl
 from layered_swim.control.rules import arm_indices
 from layered_swim.control.steering import SteeringGains
-from layered_swim.control.stroke import Stroke, StrokeSpec, build_stroke, stroke_path
+from layered_swim.control.stroke import LEVEL_OFF, Stroke, StrokeSpec, build_stroke, stroke_path
 from layered_swim.control.targets import Target
 from layered_swim.fluid import make_fluid
 from layered_swim.fluid.medium import Medium
 from layered_swim.sim.simulation import SimConfig, Simulation
-from layered_swim.state import BodyState, JointLayout, Start
+from layered_swim.state import BodyState, JointLayout, Start, lying
 from layered_swim.tasks import Task
 
 Observer = Callable[[Simulation], None]
@@ -214,7 +214,10 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
             pace = tempo_control or TempoControl(min_tempo=steer.min_tempo, glide_within_m=steer.glide_within_m,
                                                  wide_turn_rad=math.radians(steer.wide_turn_deg))
             gains = SteeringGains(steer.yaw_fraction, steer.pitch_fraction, steer.roll_fraction)
-            weights = TargetPolicy(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace)
+            level_off = (math.radians(steer.level_off_beyond_deg)
+                         if LEVEL_OFF in stroke.perturbations and lying(stroke.start.posture) else None)
+            weights = TargetPolicy(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,
+                                   level_off_beyond_rad=level_off)
         else:
             weights = fixed_weights({}, tempo=tempo)
     lungs = LungControl(body.lung_air_l, body.max_lung_air_l) if stroke.steering.breathe else None

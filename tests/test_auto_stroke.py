@@ -100,3 +100,23 @@ def test_auto_leaves_a_held_target_the_moment_it_jumps_away():
     assert 9.0 <= left_s < 9.05
     _, _, cycle_start_s, cycles_per_s = next(row for row in seen if row[0] >= left_s - 1e-9)
     assert (left_s - cycle_start_s) * cycles_per_s < 0.95      # mid-cycle
+
+
+def test_after_treading_water_the_breaststroke_levels_off_and_gets_away_sooner():
+    """Standing after a hold, the breaststroke's level-off sequence lays the body down in a few
+    cycles: 8 s after the target jumps 8 m ahead it is ~3 m nearer than with the pitch
+    correction alone (2.4 against 5.7 m when measured)."""
+    jump = StationTarget(np.array([[2.5, 0.0, -0.3], [10.5, 0.0, -0.3]]), np.array([0.0, 9.0]))
+    left_m = {}
+    for level_off in (True, False):
+        episode = Episode("auto", FollowTarget(jump))
+        policy = episode.controller.controllers[TURN].policy
+        assert policy.level_off_beyond_rad is not None      # the shipped breaststroke has one
+        if not level_off:
+            policy.level_off_beyond_rad = None
+        try:
+            episode.run(17.0)
+            left_m[level_off] = float(np.linalg.norm(episode.sim.state.com_m - [10.5, 0.0, -0.3]))
+        finally:
+            episode.close()
+    assert left_m[True] < 3.5 and left_m[True] < left_m[False] - 1.5

@@ -12,9 +12,9 @@ from layered_swim.control.layered import CycleChoice, Layers, LayeredController,
 from layered_swim.body.layout import joint_layout
 from layered_swim.geometry import quat_multiply
 from layered_swim.control.rules import arm_indices, rule_offsets
-from layered_swim.control.steering import Attitude, wanted_turns
-from layered_swim.control.stroke import (JointKeys, RulesSpec, StrokeSpec, build_stroke, load_stroke, mirrored_keys,
-                                         stroke_path)
+from layered_swim.control.steering import Attitude, attitude_of, wanted_turns
+from layered_swim.control.stroke import (LEVEL_OFF, JointKeys, PerturbationSpec, RulesSpec, StrokeSpec, build_stroke,
+                                         load_stroke, mirrored_keys, stroke_path)
 from layered_swim.control.policy import Lead, TargetPolicy, TempoControl
 from layered_swim.control.targets import FixedTarget, TrajectoryTarget, load_trajectory
 from layered_swim.episode import Episode
@@ -229,8 +229,8 @@ def test_shipped_calibration_is_fresh_and_every_sequence_turns_monotonically(str
     with, at every tempo."""
     stroke = load_stroke(stroke_name, LAYOUT)
     shipped = load_table(stroke)                       # raises if missing or stale
-    assert set(shipped.turn_rad) == set(stroke.perturbations) == set(
-        ("pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right"))
+    assert set(shipped.turn_rad) == set(stroke.perturbations) - {LEVEL_OFF} == set(
+        ("pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right"))     # level-off: uncalibrated
     assert stroke.steering.pitch_fraction == 0.0 or "pitch" in axes
     assert stroke.steering.roll_fraction == 0.0 or "roll" in axes
     for name, rows in shipped.turn_rad.items():
@@ -331,6 +331,40 @@ def test_a_swimmer_ahead_of_its_target_waits_for_it():
     ahead = TrajectoryTarget(np.array([[2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 18.0]), 0.5, False)
     chasing = TargetPolicy(ahead, table(), "prone")(0, state, 0.0)
     assert not chasing.glide and chasing.thrust_demand == pytest.approx(1.0)
+
+
+def test_a_swimmer_starting_pitched_up_levels_off_instead_of_correcting_pitch():
+    """Starting standing up (from treading water after a jump, say), a lying stroke takes its
+    level-off sequence at full weight in place of any pitch correction until it lies; lying, or
+    pitched up mid-swim (a push), it steers as before."""
+    from scipy.spatial.transform import Rotation
+
+    lying_state = still_state(np.full(16, 1 / 16))
+    nose_up = (Rotation.from_euler("y", -60.0, degrees=True) * Rotation.from_quat(PRONE_QUAT_XYZW)).as_quat()
+    standing = BodyState(0.0, np.zeros((16, 3)), np.tile(nose_up, (16, 1)), np.zeros((16, 3)), np.zeros((16, 3)),
+                         lying_state.segments)
+    assert math.degrees(attitude_of(standing, "prone").pitch_rad) == pytest.approx(60.0)
+    pitch_table = table()
+    pitch_table.turn_rad["pitch_down"] = pitch_table.turn_rad["yaw_left"]
+    target = FixedTarget((5.0, 1.0, 0.0))
+    policy = TargetPolicy(target, pitch_table, "prone", level_off_beyond_rad=math.radians(35.0))
+    assert "pitch_down" in TargetPolicy(target, pitch_table, "prone")(0, standing, 0.0).weights
+    up = policy(0, standing, 0.0).weights
+    assert up[LEVEL_OFF] == 1.0 and not any(name.startswith("pitch_") for name in up) and up["yaw_left"] > 0
+    assert LEVEL_OFF in policy(1, standing, 0.0).weights          # still standing: still levelling
+    assert LEVEL_OFF not in policy(2, lying_state, 0.0).weights   # lying: done...
+    assert LEVEL_OFF not in policy(3, standing, 0.0).weights      # ...and a later pitch-up is not a start
+    assert LEVEL_OFF not in policy(0, lying_state, 0.0).weights
+
+
+def test_a_level_off_sequence_leaves_the_calibration_valid():
+    """Calibration swims lying down, where the level-off is never taken: adding one leaves the
+    stroke's calibration hash (and so its table) as it was."""
+    spec = load(StrokeSpec, stroke_path("front_crawl"))
+    level_off = PerturbationSpec.model_validate({"keys": {"neck": {"flexion": {0.0: 10.0}}}})
+    edited = spec.model_copy(update={"perturbations": {**spec.perturbations, LEVEL_OFF: level_off}})
+    assert build_stroke(edited, LAYOUT, "x").spec_sha256 == build_stroke(spec, LAYOUT, "x").spec_sha256
+    assert LEVEL_OFF in build_stroke(edited, LAYOUT, "x").perturbations
 
 
 def test_policy_asks_for_thrust_only_when_far_and_ahead():

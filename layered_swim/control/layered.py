@@ -18,7 +18,7 @@ from layered_swim.config import ConfigError
 from layered_swim.control.lungs import LungControl
 from layered_swim.control.rules import ArmIndices, rule_offsets
 from layered_swim.control.steering import forward_axis, shoulder_roll
-from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
+from layered_swim.control.stroke import ALL_SEQUENCES, Stroke
 from layered_swim.control.targets import Target
 from layered_swim.geometry import ease, unit_vector
 from layered_swim.state import BodyState, JointLayout
@@ -166,7 +166,7 @@ class LayeredController:
             return self.choice.weights
         eased = ease(progress)
         # A fixed order: the offsets are summed in it, and a set's order changes with the hash seed.
-        names = [n for n in SEQUENCE_NAMES if n in self.choice.weights or n in self._previous_weights]
+        names = [n for n in ALL_SEQUENCES if n in self.choice.weights or n in self._previous_weights]
         return {n: self._previous_weights.get(n, 0.0) + eased * (self.choice.weights.get(n, 0.0) - self._previous_weights.get(n, 0.0))
                 for n in names}
 
@@ -194,7 +194,7 @@ class LayeredController:
 
 def fixed_weights(weights: dict[str, float], from_cycle: int = 0, tempo: float = 1.0) -> WeightPolicy:
     """A scripted policy: ``weights`` from cycle ``from_cycle`` on (calibration, experiments)."""
-    unknown = set(weights) - set(SEQUENCE_NAMES)
+    unknown = set(weights) - set(ALL_SEQUENCES)
     if unknown:
         raise ValueError(f"unknown perturbation sequences {sorted(unknown)}")
 

@@ -15,7 +15,8 @@ import numpy as np
 
 from layered_swim.control.calibration import CalibrationTable
 from layered_swim.control.layered import CycleChoice
-from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, bearing_error, wanted_turns
+from layered_swim.control.stroke import LEVEL_OFF
+from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, bearing_error, glide_pitch, wanted_turns
 from layered_swim.control.targets import Target
 from layered_swim.state import BodyState
 
@@ -81,9 +82,15 @@ class Lead:
 
 class TargetPolicy:
     def __init__(self, target: Target, table: CalibrationTable, posture: str,
-                 gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead: Lead = Lead()):
+                 gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead: Lead = Lead(),
+                 level_off_beyond_rad: float | None = None):
+        """``level_off_beyond_rad``: starting (cycle 0) pitched nose up by more than this beyond
+        any climb toward the target, take the stroke's ``level_off`` sequence instead of a pitch
+        correction every cycle until it is not (None: it has none)."""
         self.target, self.table, self.posture, self.lead = target, table, posture, lead
         self.gains, self.tempo_control = gains, tempo
+        self.level_off_beyond_rad = level_off_beyond_rad
+        self._levelling = False
         self.last_wanted: dict[str, float] = {}
 
     def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
@@ -109,7 +116,16 @@ class TargetPolicy:
                                         self.table.pace.roll_at(tempo))
         glide = ((distance < self.tempo_control.glide_within_m or (waiting and self.tempo_control.glide_within_m > 0))
                  and abs(heading_error) < self.tempo_control.easy_turn_rad)
+        weights = {} if glide else self.table.weights_for(self.last_wanted, tempo)
+        # Started standing up (from treading water), it levels off until it lies; climbing steeply
+        # to a target far above (sunk in light water) does not count: there the pitch is the climb.
+        # Only at a start: mid-swim, a push that pitches it up is for the pitch correction.
+        climb_rad = max(0.0, glide_pitch(position, target, self.gains))
+        self._levelling = (cycle == 0 or self._levelling) and self.level_off_beyond_rad is not None and (
+            att.pitch_rad - climb_rad > self.level_off_beyond_rad)
+        if self._levelling:
+            weights = {name: w for name, w in weights.items() if not name.startswith("pitch_")}
+            weights[LEVEL_OFF] = 1.0
         # Near the target, or turning hard, the rules stop seeking more thrust (Yang 4.4: more force
         # only where more is wanted); else they speed the swimmer past a slow target.
-        return CycleChoice({} if glide else self.table.weights_for(self.last_wanted, tempo), tempo, glide,
-                           thrust_demand=drive)
+        return CycleChoice(weights, tempo, glide, thrust_demand=drive)

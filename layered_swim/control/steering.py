@@ -77,6 +77,13 @@ def wanted_turns(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,
     turns = {"yaw": gains.yaw_fraction * yaw_error, "pitch": 0.0,
              "roll": gains.roll_fraction * (att.roll_rad - level_roll_rad)}
     if lying(posture):
-        glide = max(-gains.max_glide_pitch_rad, min(gains.max_glide_pitch_rad, math.atan2(delta[2], horizontal)))
-        turns["pitch"] = gains.pitch_fraction * (glide - att.pitch_rad)
+        turns["pitch"] = gains.pitch_fraction * (glide_pitch(position_m, target_m, gains) - att.pitch_rad)
     return turns
+
+
+def glide_pitch(position_m: np.ndarray, target_m: np.ndarray, gains: SteeringGains = SteeringGains()) -> float:
+    """The pitch (+ nose up) a lying swimmer steers toward: the angle to the target's depth,
+    within +-``max_glide_pitch_rad``."""
+    delta = np.asarray(target_m, float) - np.asarray(position_m, float)
+    angle = math.atan2(delta[2], math.hypot(delta[0], delta[1]))
+    return max(-gains.max_glide_pitch_rad, min(gains.max_glide_pitch_rad, angle))

@@ -44,8 +44,14 @@ class StartSpec(Strict):
     speed_m_s: float = Field(0.0, ge=0.0, le=3.0)
 
 
+# The steering sequences, each calibrated (turn per cycle against weight and tempo).
 SEQUENCE_NAMES = ("pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right")
-Sequence = Literal["pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right"]
+# Lying down from upright (a lying stroke started from treading water): not calibrated, taken at
+# weight 1 in place of the pitch correction while the body is pitched up by more than
+# ``steering.level_off_beyond_deg`` beyond any climb toward the target.
+LEVEL_OFF = "level_off"
+ALL_SEQUENCES = SEQUENCE_NAMES + (LEVEL_OFF,)
+Sequence = Literal["pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right", "level_off"]
 
 
 class PerturbationSpec(Strict):
@@ -89,6 +95,10 @@ class SteeringSpec(Strict):
     glide_moving_joints: list[str] = []
     # The tempo falls from full with the target 30 deg off the heading to min_tempo this far off.
     wide_turn_deg: float = Field(90.0, gt=30.0, le=180.0)
+    # Pitched nose up by more than this beyond any climb toward the target at a cycle's start, a
+    # lying stroke with a ``level_off`` sequence takes it instead of correcting pitch (standing, a
+    # pitch correction does little).
+    level_off_beyond_deg: float = Field(35.0, gt=0.0, le=90.0)
     breathe: bool = False           # breathe out to sink and in to rise toward the target's depth
 
 
@@ -305,8 +315,10 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
     if k is not None:
         raise ConfigError(f"{source}: field 'trim.joints': {layout.names[k]} with its trim leaves the range of motion")
     # What calibration measures: it swims without the rules, and the steering settings only read
-    # its table, so both stay out; so does the trim, nothing in the water calibration swims in.
-    digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude={"steering", "rules", "trim"}),
+    # its table, so both stay out; so does the trim, nothing in the water calibration swims in,
+    # and the level-off, which steering takes only standing.
+    exclude = {"steering": True, "rules": True, "trim": True, "perturbations": {LEVEL_OFF}}
+    digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude=exclude),
                                        sort_keys=True).encode()).hexdigest()
     return Stroke(spec.name, spec.description, spec.period_s, spec.start, basic, perturbations, spec.rules,
                   spec.steering, glide_moving, dict(spec.pd_gain_scale), source, digest, spec.trim, trim)
