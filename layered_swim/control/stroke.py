@@ -47,11 +47,11 @@ class StartSpec(Strict):
 # The steering sequences, each calibrated (turn per cycle against weight and tempo).
 SEQUENCE_NAMES = ("pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right")
 # Lying down from upright (a lying stroke started from treading water): not calibrated, taken at
-# weight 1 in place of the pitch correction while the body is pitched up by more than
-# ``steering.level_off_beyond_deg`` beyond any climb toward the target.
+# weight 1 in place of the pitch correction by a stroke that starts pitched up by more than
+# ``steering.level_off_beyond_deg`` beyond any climb toward the target, until it lies.
 LEVEL_OFF = "level_off"
 ALL_SEQUENCES = SEQUENCE_NAMES + (LEVEL_OFF,)
-Sequence = Literal["pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right", "level_off"]
+Sequence = Literal[ALL_SEQUENCES]
 
 
 class PerturbationSpec(Strict):
@@ -95,9 +95,9 @@ class SteeringSpec(Strict):
     glide_moving_joints: list[str] = []
     # The tempo falls from full with the target 30 deg off the heading to min_tempo this far off.
     wide_turn_deg: float = Field(90.0, gt=30.0, le=180.0)
-    # Pitched nose up by more than this beyond any climb toward the target at a cycle's start, a
-    # lying stroke with a ``level_off`` sequence takes it instead of correcting pitch (standing, a
-    # pitch correction does little).
+    # Starting pitched nose up by more than this beyond any climb toward the target, a lying
+    # stroke with a ``level_off`` sequence takes it instead of correcting pitch until it lies
+    # (standing, a pitch correction does little).
     level_off_beyond_deg: float = Field(35.0, gt=0.0, le=90.0)
     breathe: bool = False           # breathe out to sink and in to rise toward the target's depth
 
@@ -316,7 +316,7 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
         raise ConfigError(f"{source}: field 'trim.joints': {layout.names[k]} with its trim leaves the range of motion")
     # What calibration measures: it swims without the rules, and the steering settings only read
     # its table, so both stay out; so does the trim, nothing in the water calibration swims in,
-    # and the level-off, which steering takes only standing.
+    # and the level-off, which steering takes only at a start standing up.
     exclude = {"steering": True, "rules": True, "trim": True, "perturbations": {LEVEL_OFF}}
     digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude=exclude),
                                        sort_keys=True).encode()).hexdigest()
