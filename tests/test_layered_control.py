@@ -333,6 +333,25 @@ def test_a_swimmer_ahead_of_its_target_waits_for_it():
     assert not chasing.glide and chasing.thrust_demand == pytest.approx(1.0)
 
 
+def test_a_swimmer_keeps_a_moving_targets_pace_when_close_behind_it():
+    """Close behind a target moving at 0.6 m/s, it swims no slower than the tempo whose steady
+    speed is 0.6 m/s (0.75 in this table: 0.4 m/s at 0.5, 0.8 m/s at 1.0), not at its slowest."""
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
+    moving = TrajectoryTarget(np.array([[0.1, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 19.9]), 0.6, False)
+    assert TargetPolicy(moving, table(), "prone")(0, state, 0.0).tempo == pytest.approx(0.75)
+    unkept = TargetPolicy(moving, table(), "prone", tempo=TempoControl(keep_pace=False))(0, state, 0.0)
+    assert unkept.tempo == pytest.approx(TempoControl().min_tempo)
+    still = TargetPolicy(FixedTarget((0.1, 0.0, 0.0)), table(), "prone")(0, state, 0.0)
+    assert still.tempo == pytest.approx(TempoControl().min_tempo)   # a target that stays: no pace to keep
+
+
+def test_the_pace_table_read_backwards_gives_the_tempo_for_a_speed():
+    pace = Pace((0.4, 0.6, 0.8, 1.0), (0.1, 0.5, 0.9, 0.85), (0.0,) * 4, (0.0,) * 4, (0.2,) * 4)
+    assert pace.tempo_for_speed(0.7) == pytest.approx(0.7)
+    assert pace.tempo_for_speed(0.0) == pytest.approx(0.4)    # slower than its slowest: its slowest
+    assert pace.tempo_for_speed(2.0) == pytest.approx(1.0)    # faster than it swims: full tempo
+
+
 def test_a_swimmer_starting_pitched_up_levels_off_instead_of_correcting_pitch():
     """Starting standing up (from treading water after a jump, say), a lying stroke takes its
     level-off sequence at full weight in place of any pitch correction until it lies; lying, or

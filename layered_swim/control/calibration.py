@@ -90,6 +90,11 @@ class Pace:
         """The unperturbed stroke's mean roll: the level the per-cycle layer steers back to."""
         return float(np.interp(tempo, self.tempos, self.roll_rad))
 
+    def tempo_for_speed(self, speed_m_s: float) -> float:
+        """The tempo that swims ``speed_m_s`` steadily (read off the rising part of the table; the end
+        tempos beyond its range)."""
+        return float(np.interp(speed_m_s, np.maximum.accumulate(self.speed_m_s), self.tempos))
+
     def speed_at(self, tempo: float) -> float:
         return float(np.interp(tempo, self.tempos, self.speed_m_s))
 

@@ -25,9 +25,12 @@ from layered_swim.state import BodyState
 class TempoControl:
     """Full tempo beyond ``far_m`` from the target, ``min_tempo`` within ``near_m``; also
     ``min_tempo`` while the target is more than ``wide_turn_rad`` off the heading (swimming slower
-    tightens the turn: speed falls faster than the turn rate)."""
+    tightens the turn: speed falls faster than the turn rate). With ``keep_pace``, never slower
+    than the tempo whose steady speed (the calibration's pace) is a moving target's own, unless
+    ahead of it: slowing below it near the target only let it get away again."""
 
     min_tempo: float = 0.5
+    keep_pace: bool = True
     glide_within_m: float = 0.0
     near_m: float = 0.2
     far_m: float = 0.6
@@ -42,6 +45,13 @@ class TempoControl:
 
     def tempo_for(self, drive: float) -> float:
         return float(self.min_tempo + (1.0 - self.min_tempo) * drive)
+
+
+STEP_S = 0.5    # the target's direction and speed are read from its move over this long
+
+
+def _step_m(target: Target, time_s: float) -> np.ndarray:
+    return target.position(time_s + STEP_S) - target.position(time_s)
 
 
 @dataclass(frozen=True)
@@ -72,9 +82,12 @@ class Lead:
         place_s = max(time_s, self.place_on_path_s(target, time_s, position_m))
         return target.position(place_s + self.seconds(target, place_s)), place_s - time_s
 
+    def speed_m_s(self, target: Target, time_s: float) -> float:
+        """The target's speed along its path at ``time_s``."""
+        return float(np.linalg.norm(_step_m(target, time_s))) / STEP_S
+
     def seconds(self, target: Target, time_s: float) -> float:
-        now = target.position(time_s + 0.5) - target.position(time_s)
-        later = target.position(time_s + self.bend_s + 0.5) - target.position(time_s + self.bend_s)
+        now, later = _step_m(target, time_s), _step_m(target, time_s + self.bend_s)
         norms = float(np.linalg.norm(now) * np.linalg.norm(later))
         bend = math.acos(max(-1.0, min(1.0, float(now @ later) / norms))) if norms > 1e-12 else 0.0
         return self.straight_s + (self.bend_s - self.straight_s) * min(1.0, bend / self.full_bend_rad)
@@ -112,6 +125,9 @@ class TargetPolicy:
         waiting = ahead_of_target_s > self.lead.wait_ahead_s
         drive = 0.0 if waiting else self.tempo_control.drive(distance, heading_error)
         tempo = self.tempo_control.tempo_for(drive)
+        if self.tempo_control.keep_pace and not waiting and getattr(self.target, "foresight", True):
+            own_pace = self.table.pace.tempo_for_speed(self.lead.speed_m_s(self.target, state.time_s + ahead_of_target_s))
+            tempo = max(tempo, min(1.0, own_pace))
         self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains,
                                         self.table.pace.roll_at(tempo))
         glide = ((distance < self.tempo_control.glide_within_m or (waiting and self.tempo_control.glide_within_m > 0))
