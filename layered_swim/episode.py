@@ -217,7 +217,7 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
             level_off = (math.radians(steer.level_off_beyond_deg)
                          if LEVEL_OFF in stroke.perturbations and lying(stroke.start.posture) else None)
             weights = TargetPolicy(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,
-                                   level_off_beyond_rad=level_off)
+                                   level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo)
         else:
             weights = fixed_weights({}, tempo=tempo)
     lungs = LungControl(body.lung_air_l, body.max_lung_air_l) if stroke.steering.breathe else None

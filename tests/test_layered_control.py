@@ -374,6 +374,11 @@ def test_a_swimmer_starting_pitched_up_levels_off_instead_of_correcting_pitch():
     assert LEVEL_OFF not in policy(2, lying_state, 0.0).weights   # lying: done...
     assert LEVEL_OFF not in policy(3, standing, 0.0).weights      # ...and a later pitch-up is not a start
     assert LEVEL_OFF not in policy(0, lying_state, 0.0).weights
+    # Levelling off, it kicks at its level-off tempo even for a target behind (which would slow it).
+    behind = TargetPolicy(FixedTarget((-5.0, 1.0, 0.0)), pitch_table, "prone", level_off_beyond_rad=math.radians(35.0),
+                          level_off_tempo=1.2)
+    assert behind(0, standing, 0.0).tempo == 1.2
+    assert behind(1, lying_state, 0.0).tempo == pytest.approx(TempoControl().min_tempo)
 
 
 def test_a_level_off_sequence_leaves_the_calibration_valid():

@@ -96,13 +96,13 @@ class Lead:
 class TargetPolicy:
     def __init__(self, target: Target, table: CalibrationTable, posture: str,
                  gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead: Lead = Lead(),
-                 level_off_beyond_rad: float | None = None):
+                 level_off_beyond_rad: float | None = None, level_off_tempo: float = 1.0):
         """``level_off_beyond_rad``: starting (cycle 0) pitched nose up by more than this beyond
         any climb toward the target, take the stroke's ``level_off`` sequence instead of a pitch
-        correction every cycle until it is not (None: it has none)."""
+        correction, at ``level_off_tempo``, every cycle until it is not (None: it has none)."""
         self.target, self.table, self.posture, self.lead = target, table, posture, lead
         self.gains, self.tempo_control = gains, tempo
-        self.level_off_beyond_rad = level_off_beyond_rad
+        self.level_off_beyond_rad, self.level_off_tempo = level_off_beyond_rad, level_off_tempo
         self._levelling = False
         self.last_wanted: dict[str, float] = {}
 
@@ -119,12 +119,19 @@ class TargetPolicy:
         att = Attitude(now.heading_rad, now.pitch_rad, now.roll_rad if mean_roll_rad is None else mean_roll_rad)
         heading_error = bearing_error(position, target, att.heading_rad)
         distance = float(np.linalg.norm(self.target.position(state.time_s) - position))
+        # Started standing up (from treading water), it levels off until it lies; climbing steeply
+        # to a target far above (sunk in light water) does not count: there the pitch is the climb.
+        # Only at a start: mid-swim, a push that pitches it up is for the pitch correction.
+        climb_rad = max(0.0, glide_pitch(position, target, self.gains))
+        self._levelling = (cycle == 0 or self._levelling) and self.level_off_beyond_rad is not None and (
+            att.pitch_rad - climb_rad > self.level_off_beyond_rad)
         # Ahead of the target along its path: wait for it at the slowest tempo (turning at full tempo
         # instead carried the breaststroke further out of the figure-eight), gliding where the stroke
         # glides to wait (gliding, the breaststroke's depth drifted 0.27 m off a diving target's).
         waiting = ahead_of_target_s > self.lead.wait_ahead_s
         drive = 0.0 if waiting else self.tempo_control.drive(distance, heading_error)
-        tempo = self.tempo_control.tempo_for(drive)
+        # Levelling off, kick at the level-off tempo, even for a target behind: the faster kick lies it down sooner.
+        tempo = self.level_off_tempo if self._levelling else self.tempo_control.tempo_for(drive)
         if self.tempo_control.keep_pace and not waiting and getattr(self.target, "foresight", True):
             own_pace = self.table.pace.tempo_for_speed(self.lead.speed_m_s(self.target, state.time_s + ahead_of_target_s))
             tempo = max(tempo, min(1.0, own_pace))
@@ -133,12 +140,6 @@ class TargetPolicy:
         glide = ((distance < self.tempo_control.glide_within_m or (waiting and self.tempo_control.glide_within_m > 0))
                  and abs(heading_error) < self.tempo_control.easy_turn_rad)
         weights = {} if glide else self.table.weights_for(self.last_wanted, tempo)
-        # Started standing up (from treading water), it levels off until it lies; climbing steeply
-        # to a target far above (sunk in light water) does not count: there the pitch is the climb.
-        # Only at a start: mid-swim, a push that pitches it up is for the pitch correction.
-        climb_rad = max(0.0, glide_pitch(position, target, self.gains))
-        self._levelling = (cycle == 0 or self._levelling) and self.level_off_beyond_rad is not None and (
-            att.pitch_rad - climb_rad > self.level_off_beyond_rad)
         if self._levelling:
             weights = {name: w for name, w in weights.items() if not name.startswith("pitch_")}
             weights[LEVEL_OFF] = 1.0

@@ -99,6 +99,7 @@ class SteeringSpec(Strict):
     # stroke with a ``level_off`` sequence takes it instead of correcting pitch until it lies
     # (standing, a pitch correction does little).
     level_off_beyond_deg: float = Field(35.0, gt=0.0, le=90.0)
+    level_off_tempo: float = Field(1.0, ge=0.1, le=1.5)    # the tempo of those level-off cycles
     breathe: bool = False           # breathe out to sink and in to rise toward the target's depth
 
 
