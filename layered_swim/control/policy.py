@@ -3,8 +3,8 @@
 At each cycle start: where is the target relative to the swimmer (heading error, depth, and the
 shoulder roll averaged over the last cycle against the stroke's own), how much of that to correct
 this cycle, and which weights the calibration table says produce those turns. The cycle's tempo
-slows the stroke near the target so the swimmer does not overshoot a slow target, and the rules
-are told how much more thrust is wanted.
+slows the stroke near the target so the swimmer does not overshoot a slow target (but not below
+a moving target's own pace), and the rules are told how much more thrust is wanted.
 """
 from __future__ import annotations
 
@@ -130,11 +130,11 @@ class TargetPolicy:
         # glides to wait (gliding, the breaststroke's depth drifted 0.27 m off a diving target's).
         waiting = ahead_of_target_s > self.lead.wait_ahead_s
         drive = 0.0 if waiting else self.tempo_control.drive(distance, heading_error)
-        # Levelling off, kick at the level-off tempo, even for a target behind: the faster kick lies it down sooner.
+        # Levelling off, kick at the level-off tempo even for a target behind: a fast kick lies it down sooner.
         tempo = self.level_off_tempo if self._levelling else self.tempo_control.tempo_for(drive)
         if self.tempo_control.keep_pace and not waiting and getattr(self.target, "foresight", True):
-            own_pace = self.table.pace.tempo_for_speed(self.lead.speed_m_s(self.target, state.time_s + ahead_of_target_s))
-            tempo = max(tempo, min(1.0, own_pace))
+            target_speed_m_s = self.lead.speed_m_s(self.target, state.time_s + ahead_of_target_s)
+            tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(target_speed_m_s)))
         self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains,
                                         self.table.pace.roll_at(tempo))
         glide = ((distance < self.tempo_control.glide_within_m or (waiting and self.tempo_control.glide_within_m > 0))
