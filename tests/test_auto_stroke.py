@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from layered_swim.config import ConfigError
-from layered_swim.control.auto import HOLD, SPRINT, TURN, StrokeChoice, target_speed_m_s
-from layered_swim.control.targets import FixedTarget, StationTarget, load_trajectory
+from layered_swim.control.auto import HOLD, SPRINT, TURN, StrokeChoice
+from layered_swim.control.targets import FixedTarget, StationTarget, load_trajectory, target_speed_m_s
 from layered_swim.episode import Episode
 from layered_swim.tasks import FollowTarget
 

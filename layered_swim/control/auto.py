@@ -28,7 +28,7 @@ import numpy as np
 from layered_swim.control.layered import LayeredController
 from layered_swim.geometry import ease
 from layered_swim.control.steering import attitude_of, bearing_error
-from layered_swim.control.targets import Target
+from layered_swim.control.targets import Target, target_speed_m_s
 from layered_swim.state import BodyState
 
 AUTO = "auto"
@@ -60,14 +60,6 @@ class StrokeChoice:
                 active == SPRINT and distance_m > self.sprint_until_m and error < self.sprint_keep_rad):
             return SPRINT
         return TURN
-
-
-def target_speed_m_s(target: Target, time_s: float) -> float:
-    """How fast the target moves now: over the next second where its path is known ahead, over
-    the last one where it is not (a mouse, a jump)."""
-    if getattr(target, "foresight", True):
-        return float(np.linalg.norm(target.position(time_s + 1.0) - target.position(time_s)))
-    return float(np.linalg.norm(target.position(time_s) - target.position(max(0.0, time_s - 1.0))))
 
 
 class AutoStrokeController:

@@ -17,7 +17,7 @@ from layered_swim.control.calibration import CalibrationTable
 from layered_swim.control.layered import CycleChoice
 from layered_swim.control.stroke import LEVEL_OFF
 from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, bearing_error, glide_pitch, wanted_turns
-from layered_swim.control.targets import Target
+from layered_swim.control.targets import Target, target_speed_m_s
 from layered_swim.state import BodyState
 
 
@@ -82,10 +82,6 @@ class Lead:
         place_s = max(time_s, self.place_on_path_s(target, time_s, position_m))
         return target.position(place_s + self.seconds(target, place_s)), place_s - time_s
 
-    def speed_m_s(self, target: Target, time_s: float) -> float:
-        """The target's speed along its path at ``time_s``."""
-        return float(np.linalg.norm(_step_m(target, time_s))) / STEP_S
-
     def seconds(self, target: Target, time_s: float) -> float:
         now, later = _step_m(target, time_s), _step_m(target, time_s + self.bend_s)
         norms = float(np.linalg.norm(now) * np.linalg.norm(later))
@@ -108,8 +104,10 @@ class TargetPolicy:
 
     def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
         position = state.com_m
-        # Aim ahead along the target's path only where it is known (not a mouse or a jump).
-        if getattr(self.target, "foresight", True):
+        # Aim ahead along the target's path (and keep its pace) only where it is known (not a mouse
+        # or a jump).
+        foresight = getattr(self.target, "foresight", True)
+        if foresight:
             target, ahead_of_target_s = self.lead.aim(self.target, state.time_s, position)
         else:
             target, ahead_of_target_s = self.target.position(state.time_s), 0.0
@@ -132,9 +130,9 @@ class TargetPolicy:
         drive = 0.0 if waiting else self.tempo_control.drive(distance, heading_error)
         # Levelling off, kick at the level-off tempo even for a target behind: a fast kick lies it down sooner.
         tempo = self.level_off_tempo if self._levelling else self.tempo_control.tempo_for(drive)
-        if self.tempo_control.keep_pace and not waiting and getattr(self.target, "foresight", True):
-            target_speed_m_s = self.lead.speed_m_s(self.target, state.time_s + ahead_of_target_s)
-            tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(target_speed_m_s)))
+        if self.tempo_control.keep_pace and not waiting and foresight:
+            speed_m_s = target_speed_m_s(self.target, state.time_s + ahead_of_target_s, STEP_S)
+            tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(speed_m_s)))
         self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains,
                                         self.table.pace.roll_at(tempo))
         glide = ((distance < self.tempo_control.glide_within_m or (waiting and self.tempo_control.glide_within_m > 0))

@@ -129,6 +129,14 @@ class StationTarget:
         return self._points.copy()
 
 
+def target_speed_m_s(target: Target, time_s: float, over_s: float = 1.0) -> float:
+    """How fast the target moves now: over the next ``over_s`` where its path is known ahead, over
+    the last ``over_s`` where it is not (a mouse, a jump)."""
+    if getattr(target, "foresight", True):
+        return float(np.linalg.norm(target.position(time_s + over_s) - target.position(time_s))) / over_s
+    return float(np.linalg.norm(target.position(time_s) - target.position(max(0.0, time_s - over_s)))) / over_s
+
+
 # ---------------------------------------------------------------- file schemas
 
 Length_m = between(0.0, 1e4, above=True)
