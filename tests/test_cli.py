@@ -7,6 +7,11 @@ from pathlib import Path
 
 import pytest
 
+from layered_swim.body.layout import joint_layout
+from layered_swim.body.model import load_body
+from layered_swim.control.calibration import load_table
+from layered_swim.control.stroke import load_stroke
+
 REPO = Path(__file__).resolve().parents[1]
 SUMMARY_KEYS = {"stroke", "seconds", "mean_speed_m_s", "stroke_rate_cpm", "distance_per_cycle_m",
                 "peak_shoulder_roll_deg", "mean_head_height_m", "horizontal_drift_m_s",
@@ -34,10 +39,15 @@ def test_strokes_lists_rest():
     assert result.returncode == 0, result.stderr
     rest = [line for line in result.stdout.splitlines() if line.startswith("rest ")]
     assert rest and "15.0" in rest[0] and "float" in rest[0]
-    # Each calibrated stroke's speed range, from its slowest working tempo to the fastest measured.
+    # Each calibrated stroke's speed range, from its slowest working tempo (its min_tempo) to the
+    # fastest measured, read off its calibration table's pace.
     crawl = [line for line in result.stdout.splitlines() if line.startswith("front_crawl ")][0]
     low, high = (float(v) for v in crawl.split()[2].split("-"))
-    assert 1.0 < low < high < 2.0
+    stroke = load_stroke("front_crawl", joint_layout(load_body()))
+    pace = load_table(stroke).pace
+    assert low == pytest.approx(pace.speed_at(stroke.steering.min_tempo), abs=0.005)
+    assert high == pytest.approx(max(pace.speed_m_s), abs=0.005)
+    assert 0.5 < low < high < 2.0
 
 
 def test_run_json(tmp_path):
