@@ -101,9 +101,8 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
                + f"In a {task.duration_s:g} s episode our per-cycle layer decides about {task.duration_s / period_s:.1f} "
                f"times ({period_s:.2f} s crawl cycles) and can slow the stroke only to {GOAL_TEMPO.min_tempo:g} of its "
                f"tempo, while a 0.5 m/s current carries the body {0.5 * task.duration_s:g} m, more than the "
-               f"{task.length_m:.1f} m to the goal. SWIM's quiet-water errors: Pos 0.126 m, Prog 0.712, Dev 0.037 m; "
-               "the crawl cannot swim slower than ~0.9 of its tempo without stalling, so it keeps to the schedule "
-               "by gliding. Vel is not reported: our strokes are key poses, not a motion-capture reference to "
+               f"{task.length_m:.1f} m to the goal. SWIM's quiet-water errors: Pos 0.126 m, Prog 0.712, Dev 0.037 m. "
+               "Vel is not reported: our strokes are key poses, not a motion-capture reference to "
                "compare joint velocities with.")
     setting = (f"{STROKE}, all three layers, SWIM's {POOL} pool (3 m x 1.5 m; goals 1.5 m ahead, 0 and +-0.375 m "
                "across, 4 s), uniform current of the given speed and direction; diagonal = between +x and +y.")
