@@ -213,7 +213,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
         if layers.cycle:
             pace = tempo_control or TempoControl(min_tempo=steer.min_tempo, glide_within_m=steer.glide_within_m,
                                                  wide_turn_rad=math.radians(steer.wide_turn_deg))
-            gains = SteeringGains(steer.yaw_fraction, steer.pitch_fraction, steer.roll_fraction)
+            gains = SteeringGains(steer.yaw_fraction, steer.pitch_fraction, steer.roll_fraction,
+                                  over_weight_within_rad=math.radians(steer.over_weight_within_deg))
             level_off = (math.radians(steer.level_off_beyond_deg)
                          if LEVEL_OFF in stroke.perturbations and lying(stroke.start.posture) else None)
             weights = TargetPolicy(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,

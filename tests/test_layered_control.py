@@ -6,13 +6,13 @@ import pytest
 
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, load
-from layered_swim.analysis.calibrate import _measure
+from layered_swim.analysis.calibrate import _measure, weight_grid
 from layered_swim.control.calibration import CalibrationTable, Pace, load_table
 from layered_swim.control.layered import CycleChoice, Layers, LayeredController, fixed_weights
 from layered_swim.body.layout import joint_layout
 from layered_swim.geometry import quat_multiply
 from layered_swim.control.rules import arm_indices, rule_offsets
-from layered_swim.control.steering import Attitude, attitude_of, wanted_turns
+from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, wanted_turns
 from layered_swim.control.stroke import (LEVEL_OFF, JointKeys, PerturbationSpec, RulesSpec, StrokeSpec, build_stroke,
                                          load_stroke, mirrored_keys, stroke_path)
 from layered_swim.control.policy import Lead, TargetPolicy, TempoControl
@@ -196,6 +196,17 @@ def test_missing_or_stale_calibration_is_a_clear_error(tmp_path):
         load_table(stroke, directory=tmp_path)
 
 
+def test_a_table_calibrated_to_another_max_weight_is_a_clear_error(tmp_path):
+    stroke = load_stroke("breaststroke", LAYOUT)            # steering.max_weight 1
+    (tmp_path / "breaststroke.yaml").write_text(
+        f"stroke: breaststroke\nstroke_sha256: {stroke.spec_sha256}\nweights: [0, 0.75, 1.5]\ntempos: [1]\n"
+        "pace: {tempos: [1], speed_m_s: [1], roll_deg: [0], pitch_deg: [10], depth_m: [0.2]}\n"
+        "turn_deg_per_cycle: {yaw_left: [[0, 1, 2]]}\n")
+    with pytest.raises(ConfigError, match="up to weight 1.5.*'steering.max_weight' is 1; run `layered-swim calibrate"):
+        load_table(stroke, directory=tmp_path)
+    assert weight_grid(1.5) == (0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5) and weight_grid(1.0)[-1] == 1.0
+
+
 def test_a_pace_table_needs_one_value_per_tempo(tmp_path):
     stroke = load_stroke("breaststroke", LAYOUT)
     (tmp_path / "breaststroke.yaml").write_text(
@@ -225,17 +236,23 @@ def test_short_follow_gets_closer_to_a_fixed_target():
     # "Status and known gaps"); their steering corrects the heading only.
     ("backstroke", ("yaw",)), ("butterfly", ("yaw",))])
 def test_shipped_calibration_is_fresh_and_every_sequence_turns_monotonically(stroke_name, axes):
-    """Yang Fig. 11: more weight, more turn, for every sequence of the axes the stroke steers
-    with, at every tempo."""
+    """Yang Fig. 11: more weight, more turn, for every sequence of the axes given, at every tempo,
+    over weights 0-1; beyond 1 (up to ``steering.max_weight``) too, for the axes it steers with."""
     stroke = load_stroke(stroke_name, LAYOUT)
     shipped = load_table(stroke)                       # raises if missing or stale
     assert set(shipped.turn_rad) == set(stroke.perturbations) - {LEVEL_OFF} == set(
         ("pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right"))     # level-off: uncalibrated
     assert stroke.steering.pitch_fraction == 0.0 or "pitch" in axes
     assert stroke.steering.roll_fraction == 0.0 or "roll" in axes
+    assert shipped.weights[-1] == stroke.steering.max_weight
+    fractions = {"yaw": stroke.steering.yaw_fraction, "pitch": stroke.steering.pitch_fraction,
+                 "roll": stroke.steering.roll_fraction}
+    up_to_one = np.array(shipped.weights) <= 1.0
     for name, rows in shipped.turn_rad.items():
-        if name.split("_")[0] in axes:
-            assert np.all(np.diff(rows, axis=1) > 0), f"{stroke_name} {name}: {np.degrees(rows).round(2)}"
+        axis = name.split("_")[0]
+        if axis in axes:
+            checked = rows if fractions[axis] > 0 else rows[:, up_to_one]
+            assert np.all(np.diff(checked, axis=1) > 0), f"{stroke_name} {name}: {np.degrees(rows).round(2)}"
 
 
 def test_palm_rule_adds_forward_displacement():
@@ -312,7 +329,10 @@ def test_lead_aims_from_the_swimmers_own_place_on_the_path_when_it_is_ahead():
     line = load_trajectory("straight_line")          # x = 2 + 0.5 t, y = 0, 0.3 m deep
     lead = Lead(straight_s=1.5, bend_s=3.0)
     aim, ahead_s = lead.aim(line, 0.0, np.array([0.0, 0.5, -0.3]))      # behind: 1.5 s past the target
-    assert ahead_s == 0.0 and aim == pytest.approx([2.75, 0.0, -0.3])
+    # 2 m behind a target that waited at its start before t = 0: as far behind as the search looks.
+    assert ahead_s == pytest.approx(-lead.search_s) and aim == pytest.approx([2.75, 0.0, -0.3])
+    aim, ahead_s = lead.aim(line, 4.0, np.array([3.0, 0.5, -0.3]))      # 1 m (2 s) behind the target at x = 4
+    assert ahead_s == pytest.approx(-2.0) and aim == pytest.approx([4.75, 0.0, -0.3])
     aim, ahead_s = lead.aim(line, 0.0, np.array([4.0, 1.0, -0.3]))      # 2 m (4 s) ahead of it, off the line
     assert ahead_s == pytest.approx(4.0) and aim == pytest.approx([4.75, 0.0, -0.3])
     # A steep dive (x = 0.25 t, z = -0.3 - 0.5 t): 0.5 m along it, still at the surface, the swimmer
@@ -331,6 +351,34 @@ def test_a_swimmer_ahead_of_its_target_waits_for_it():
     ahead = TrajectoryTarget(np.array([[2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 18.0]), 0.5, False)
     chasing = TargetPolicy(ahead, table(), "prone")(0, state, 0.0)
     assert not chasing.glide and chasing.thrust_demand == pytest.approx(1.0)
+
+
+def test_a_gliding_stroke_near_its_target_glides_only_once_ahead_of_it_along_its_path():
+    """Within glide_within_m of a target on a path, 0.3 m behind it: swim on (gliding there, the
+    crawl trailed its target); 0.3 m (0.6 s) ahead: glide. A target with no path (a jump) is
+    glided to on distance alone."""
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
+    tempo = TempoControl(glide_within_m=0.4)
+    leading = TrajectoryTarget(np.array([[0.3, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 39.4]), 0.5, False)
+    assert not TargetPolicy(leading, table(), "prone", tempo=tempo)(0, state, 0.0).glide
+    trailing = TrajectoryTarget(np.array([[-0.3, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 40.6]), 0.5, False)
+    policy = TargetPolicy(trailing, table(), "prone", tempo=tempo, lead=Lead(wait_ahead_s=10.0))   # near, not waiting
+    assert policy(0, state, 0.0).glide
+    assert TargetPolicy(FixedTarget((0.3, 0.0, 0.0)), table(), "prone", tempo=tempo)(0, state, 0.0).glide
+
+
+def test_weights_above_one_only_for_a_turn_wanted_within_the_strokes_limit():
+    turns = np.radians([[0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0]])
+    pace = Pace((0.5, 1.0), (0.4, 0.8), (0.0, 0.0), (0.0, 0.0), (0.2, 0.2))
+    to_1_5 = CalibrationTable("t", "x", (0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5), (1.0,), pace,
+                              {"yaw_left": turns, "yaw_right": turns})
+    gains = SteeringGains(yaw_fraction=1.0, over_weight_within_rad=math.radians(75.0))
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
+
+    def yaw_left_weight(bearing_deg):
+        target = FixedTarget((5 * math.cos(math.radians(bearing_deg)), 5 * math.sin(math.radians(bearing_deg)), 0.0))
+        return TargetPolicy(target, to_1_5, "prone", gains=gains)(0, state, 0.0).weights["yaw_left"]
+    assert yaw_left_weight(50.0) == 1.5 and yaw_left_weight(100.0) == 1.0
 
 
 def test_a_swimmer_keeps_a_moving_targets_pace_when_close_behind_it():

@@ -83,6 +83,7 @@ def test_shipped_strokes_load(name):
     (GOOD.replace("period_s: 1.5", "period_s: -1"), ["period_s"]),
     (GOOD.replace("flexion: {0.0: 0, 0.5: 145}", "flexion: {0.0: 0, 0.5: 145"), ["line"]),
     (GOOD + "steering: {glide_moving_joints: [hip_l, tail]}\n", ["steering.glide_moving_joints", "tail"]),
+    (GOOD + "steering: {max_weight: 1.3}\n", ["steering.max_weight", "multiple of 0.25"]),
     (GOOD + "steering: {yaw_fraction: 1.5}\n", ["steering.yaw_fraction"]),
     (GOOD + "trim: {joints: {elbow_l: {flexion: 10}}}\n", ["trim.joints", "elbow_l.flexion", "range"]),
     (GOOD + "trim: {joints: {tail: {flexion: 10}}}\n", ["trim.joints.tail", "unknown joint"]),

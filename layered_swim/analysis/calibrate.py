@@ -21,7 +21,7 @@ from layered_swim.control.stroke import SEQUENCE_NAMES, Stroke
 from layered_swim.episode import Episode
 
 AXIS_INDEX = {"yaw": 0, "pitch": 1, "roll": 2}       # columns of a swim's (yaw, pitch, roll) change
-WEIGHTS = (0.0, 0.25, 0.5, 0.75, 1.0)
+WEIGHT_STEP = 0.25
 TEMPOS = (0.7, 1.0)
 PACE_TEMPOS = (0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2)     # includes TEMPOS: their drift is measured once
 SETTLE_CYCLES = 3
@@ -76,10 +76,16 @@ def _measure(job: tuple[str, str | None, float, float]) -> tuple:
             float(after[1]), float(-track[-1, 2]))
 
 
-def calibrate(stroke: Stroke, weights=WEIGHTS, tempos=TEMPOS, pace_tempos=PACE_TEMPOS, workers: int = 2,
+def weight_grid(max_weight: float) -> tuple[float, ...]:
+    """0 to ``max_weight`` (the stroke's ``steering.max_weight``) in steps of ``WEIGHT_STEP``."""
+    return tuple(float(w) for w in np.linspace(0.0, max_weight, round(max_weight / WEIGHT_STEP) + 1))
+
+
+def calibrate(stroke: Stroke, tempos=TEMPOS, pace_tempos=PACE_TEMPOS, workers: int = 2,
               progress: bool = False) -> CalibrationTable:
     """Simulate every sequence at every weight and tempo, and the unperturbed stroke at every
     pace tempo (in parallel), and build the table."""
+    weights = weight_grid(stroke.steering.max_weight)
     sequences = [name for name in SEQUENCE_NAMES if name in stroke.perturbations]
     if not sequences:
         raise ConfigError(f"{stroke.source}: the stroke has no perturbation sequences to calibrate")

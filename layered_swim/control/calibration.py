@@ -170,6 +170,9 @@ def load_table(stroke: Stroke, directory: Path = CALIBRATION_DIR) -> Calibration
         raise CalibrationError(f"{err}; {remake}") from None
     if spec.stroke_sha256 != stroke.spec_sha256:
         raise CalibrationError(f"{path}: stale calibration table (stroke file {stroke.source} changed since); {remake}")
+    if not math.isclose(spec.weights[-1], stroke.steering.max_weight):
+        raise CalibrationError(f"{path}: calibrated up to weight {spec.weights[-1]:g}, but {stroke.source} field "
+                               f"'steering.max_weight' is {stroke.steering.max_weight:g}; {remake}")
     return CalibrationTable(
         stroke=spec.stroke, stroke_sha256=spec.stroke_sha256, weights=tuple(spec.weights), tempos=tuple(spec.tempos),
         pace=Pace(tuple(spec.pace.tempos), tuple(spec.pace.speed_m_s), tuple(math.radians(a) for a in spec.pace.roll_deg),

@@ -64,6 +64,7 @@ class SteeringGains:
     pitch_fraction: float = 0.5
     roll_fraction: float = 0.5
     max_glide_pitch_rad: float = math.radians(30.0)
+    over_weight_within_rad: float = math.pi    # weights above 1 only for a heading turn wanted within this
 
 
 def wanted_turns(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,

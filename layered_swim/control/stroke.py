@@ -93,6 +93,11 @@ class SteeringSpec(Strict):
     min_tempo: float = Field(0.5, ge=0.1, le=1.0)
     glide_within_m: float = Field(0.0, ge=0.0, le=10.0)
     glide_moving_joints: list[str] = []
+    # The largest weight the per-cycle layer gives a sequence (its offsets times this; the pose stays
+    # inside the joints' ranges); `calibrate` measures turns up to it.
+    max_weight: float = Field(1.0, ge=0.25, le=3.0, multiple_of=0.25)
+    # Weights above 1 only for a heading turn wanted within this (a wider one takes cycles anyway).
+    over_weight_within_deg: float = Field(180.0, gt=0.0, le=180.0)
     # The tempo falls from full with the target 30 deg off the heading to min_tempo this far off.
     wide_turn_deg: float = Field(90.0, gt=30.0, le=180.0)
     # Starting pitched nose up by more than this beyond any climb toward the target, a lying
