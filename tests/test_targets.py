@@ -124,9 +124,11 @@ def test_shipped_trajectories_load(name):
 
 def test_required_files_are_shipped():
     assert {"figure_eight", "circle", "zigzag", "dive_and_surface", "straight_line", "square", "small_loops",
-            "deep_dive", "stationary_behind", "jumping"} <= set(available_trajectories())
+            "deep_dive", "stationary_behind", "jumping", "sinusoid"} <= set(available_trajectories())
     dive = load_trajectory("dive_and_surface").path_points(2000)
     assert dive[:, 2].min() == pytest.approx(-2.0) and dive[0, 2] == dive[-1, 2] == pytest.approx(-0.3)
+    weave = load_trajectory("sinusoid").path_points(4000)          # 1.5 m either side of the x axis
+    assert weave[:, 1].max() == pytest.approx(1.5, abs=1e-3) and weave[:, 1].min() == pytest.approx(-1.5, abs=1e-3)
 
 
 def test_fixed_and_movable_targets():
