@@ -83,7 +83,7 @@ def _parser() -> argparse.ArgumentParser:
                                                           "controller (--layers then comes from the policy)")
     follow.add_argument("--seeds", type=int, metavar="N",
                         help="swim N times from starts moved by up to 10 deg and 0.3 m, and report each headline "
-                             "number's median (and range) over them")
+                             "number's median (and range) over them (with --policy too)")
     _parallel_options(follow)
     _backend_option(follow, pool="large")       # a trajectory's target starts 2 m ahead
 
@@ -446,7 +446,6 @@ def _cmd_calibrate(args) -> None:
 
 
 def _cmd_follow(args) -> None:
-    from layered_swim.config import ConfigError
     from layered_swim.control.layered import Layers
     from layered_swim.runs import default_out_dir, follow_run
 
@@ -455,16 +454,9 @@ def _cmd_follow(args) -> None:
         _follow_seeds(args, layers)
         return
     if args.policy:        # the residual on its own reference controller, run by its driver
-        from layered_swim.control.residual import ResidualController
-        from layered_swim.rl.env import REFERENCES
-        from layered_swim.rl.policy import Policy, ResidualDriver
+        from layered_swim.rl.policy import follow_steering
 
-        policy = Policy.load(args.policy)
-        if args.stroke != policy.env["stroke"]:
-            raise ConfigError(f"{args.policy} was trained for {policy.env['stroke']}; add --stroke {policy.env['stroke']}")
-        layers = Layers.parse(REFERENCES[policy.env["reference"]])
-        steered = {"wrap": ResidualController, "driver": lambda episode: ResidualDriver(policy, episode),
-                   "extra": {"policy": args.policy, "reference": policy.env["reference"]}}
+        layers, steered = follow_steering(args.policy, args.stroke)
     out = str(_out_dir(args, default_out_dir(f"follow-{Path(args.trajectory).stem}")))
     result = follow_run(args.trajectory, args.stroke, layers, _vector(args.current, "--current"),
                         args.density, args.seconds, out, args.backend, _fluid_settings(args), **steered)
@@ -482,11 +474,15 @@ def _follow_seeds(args, layers) -> None:
     from layered_swim.config import ConfigError
     from layered_swim.runs import default_out_dir
 
-    if args.policy or args.backend != "plate":
-        raise ConfigError("--seeds runs the layered controller on the plate backend only (no --policy, --backend sph)")
+    if args.backend != "plate":
+        raise ConfigError("--seeds runs on the plate backend only (no --backend sph)")
+    if args.policy:
+        from layered_swim.rl.policy import follow_steering
+
+        layers = follow_steering(args.policy, args.stroke)[0]     # fails here, in one line, not in every worker
     out = str(_out_dir(args, default_out_dir(f"follow-{Path(args.trajectory).stem}-seeds")))
     summary = follow_seeds(args.trajectory, args.stroke, layers, _vector(args.current, "--current"), args.density,
-                           args.seconds, args.seeds, out, max(1, args.workers), _progress(args))
+                           args.seconds, args.seeds, out, max(1, args.workers), _progress(args), policy=args.policy)
     if args.json:
         print(json.dumps({**summary, "out_dir": out}, allow_nan=False))
         return

@@ -154,6 +154,15 @@ def test_cli_train_then_goal_with_the_policy(tmp_path):
     assert follow.returncode == 0, follow.stderr
     followed = json.loads(follow.stdout)
     assert followed["reference"] == "layered" and np.isfinite(followed["mean_distance_m"])
+    # Over perturbed starts, in two worker processes (a parent holding torch once hung forked ones).
+    seeds = subprocess.run([sys.executable, "-m", "layered_swim", "follow", "straight_line", "--stroke", "front_crawl",
+                            "--seconds", "2", "--seeds", "2", "--workers", "2", "--policy", str(out / "policy.pt"),
+                            "--out", str(tmp_path / "s"), "--json"], capture_output=True, text=True, timeout=300)
+    assert seeds.returncode == 0, seeds.stderr
+    summary = json.loads(seeds.stdout)
+    assert summary["policy"] == str(out / "policy.pt") and summary["layers"] == followed["layers"]
+    distances = [r["mean_distance_m"] for r in summary["runs"]]
+    assert len(distances) == 2 and np.all(np.isfinite(distances)) and distances[0] != distances[1]
     wrong = _cli("follow", "straight_line", "--seconds", "2", "--policy", str(out / "policy.pt"), "--out", str(tmp_path / "g"))
     assert wrong.returncode == 2 and "--stroke front_crawl" in wrong.stderr
     bad = _cli("goal", "--policy", str(tmp_path / "missing.pt"))

@@ -25,9 +25,15 @@ MAX_SEEDS = 1000
 
 
 def follow_one(config: dict) -> dict:
-    """One perturbed run (module level: worker processes pickle it)."""
-    result = follow_run(config["trajectory"], config["stroke"], Layers.parse(config["layers"]), config["current_m_s"],
-                        config["density_kg_m3"], config["seconds"], seed=config["seed"], jitter=WIDE_JITTER)
+    """One perturbed run (module level: worker processes pickle it); with ``policy``, a learned
+    residual drives its reference controller."""
+    layers, steered = Layers.parse(config["layers"]), {}
+    if config.get("policy"):
+        from layered_swim.rl.policy import follow_steering
+
+        layers, steered = follow_steering(config["policy"], config["stroke"])
+    result = follow_run(config["trajectory"], config["stroke"], layers, config["current_m_s"],
+                        config["density_kg_m3"], config["seconds"], seed=config["seed"], jitter=WIDE_JITTER, **steered)
     return {k: v for k, v in result.items() if k in HEADLINES or k in ("seed", "reached_all", "stations")}
 
 
@@ -43,12 +49,13 @@ def spread(values: list) -> dict | None:
 
 def follow_seeds(trajectory: str, stroke: str, layers: Layers, current=(0.0, 0.0, 0.0), density: float | None = None,
                  seconds: float = 60.0, seeds: int = 10, out_dir: str | Path | None = None, workers: int = 2,
-                 progress: bool = False) -> dict:
+                 progress: bool = False, policy: str | None = None) -> dict:
+    """``policy``: a trained residual (its file) drives its own reference controller instead."""
     check_seconds(seconds)
     if not 1 <= seeds <= MAX_SEEDS:
         raise ConfigError(f"--seeds must be between 1 and {MAX_SEEDS}, got {seeds}")
     common = {"trajectory": trajectory, "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
-              "density_kg_m3": density, "seconds": seconds}
+              "density_kg_m3": density, "seconds": seconds, **({"policy": str(policy)} if policy else {})}
     configs = [{**common, "seed": seed} for seed in range(1, seeds + 1)]
     runs = run_sweep(follow_one, configs, None, workers, progress, desc="starts")
     summary = {**common, "seeds": seeds, "start_jitter": asdict(WIDE_JITTER),

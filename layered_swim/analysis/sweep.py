@@ -13,6 +13,7 @@ from __future__ import annotations
 import hashlib
 import inspect
 import json
+import multiprocessing
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from functools import lru_cache
 from pathlib import Path
@@ -93,7 +94,8 @@ def run_sweep(task: Callable[[dict], object], configs: list[dict], cache_dir: st
             for i in todo:
                 done(i, task(configs[i]))
         else:
-            with ProcessPoolExecutor(max_workers=workers) as pool:
+            # Spawned, not forked: a parent that has loaded torch (a policy) hangs forked children.
+            with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
                 futures = {pool.submit(task, configs[i]): i for i in todo}
                 for future in as_completed(futures):
                     done(futures[future], future.result())

@@ -49,6 +49,21 @@ class Policy:
         return env_arguments(self.env, self.reward, **changes)
 
 
+def follow_steering(policy_path: str | Path, stroke: str):
+    """The layers and ``follow_run`` arguments that put the residual in ``policy_path`` in charge
+    of a follow swim: its own reference controller, driven by ``ResidualDriver``."""
+    from layered_swim.control.layered import Layers
+    from layered_swim.control.residual import ResidualController
+    from layered_swim.rl.env import REFERENCES
+
+    policy = Policy.load(policy_path)
+    if stroke != policy.env["stroke"]:
+        raise ConfigError(f"{policy_path} was trained for {policy.env['stroke']}; add --stroke {policy.env['stroke']}")
+    return Layers.parse(REFERENCES[policy.env["reference"]]), {
+        "wrap": ResidualController, "driver": lambda episode: ResidualDriver(policy, episode),
+        "extra": {"policy": str(policy_path), "reference": policy.env["reference"]}}
+
+
 def env_arguments(env: dict, reward: dict, **changes) -> dict:
     """``SwimGoalEnv``'s keyword arguments from a config's ``env`` and ``reward`` sections."""
     return {**env, "reward_weights": RewardWeights(**reward), **changes}
