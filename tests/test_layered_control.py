@@ -184,24 +184,26 @@ def test_rule_offsets_fade_and_stay_within_their_limits():
     assert np.abs(offsets).max() < 1e-3
 
 
+def write_breaststroke_table(directory, sha256, weights="[0, 1]", yaw_left="[[0, 1]]",
+                             pace="{tempos: [1], speed_m_s: [1], roll_deg: [0], pitch_deg: [10], depth_m: [0.2]}"):
+    """A hand-written calibration table for the breaststroke in ``directory``."""
+    (directory / "breaststroke.yaml").write_text(
+        f"stroke: breaststroke\nstroke_sha256: {sha256}\nweights: {weights}\ntempos: [1]\n"
+        f"pace: {pace}\nturn_deg_per_cycle: {{yaw_left: {yaw_left}}}\n")
+
+
 def test_missing_or_stale_calibration_is_a_clear_error(tmp_path):
     stroke = load_stroke("breaststroke", LAYOUT)
     with pytest.raises(ConfigError, match="calibrate --stroke breaststroke"):
         load_table(stroke, directory=tmp_path)
-    (tmp_path / "breaststroke.yaml").write_text(
-        "stroke: breaststroke\nstroke_sha256: old\nweights: [0, 1]\ntempos: [1]\n"
-        "pace: {tempos: [1], speed_m_s: [1], roll_deg: [0], pitch_deg: [10], depth_m: [0.2]}\n"
-        "turn_deg_per_cycle: {yaw_left: [[0, 1]]}\n")
+    write_breaststroke_table(tmp_path, "old")
     with pytest.raises(ConfigError, match="stale"):
         load_table(stroke, directory=tmp_path)
 
 
 def test_a_table_calibrated_to_another_max_weight_is_a_clear_error(tmp_path):
     stroke = load_stroke("breaststroke", LAYOUT)            # steering.max_weight 1
-    (tmp_path / "breaststroke.yaml").write_text(
-        f"stroke: breaststroke\nstroke_sha256: {stroke.spec_sha256}\nweights: [0, 0.75, 1.5]\ntempos: [1]\n"
-        "pace: {tempos: [1], speed_m_s: [1], roll_deg: [0], pitch_deg: [10], depth_m: [0.2]}\n"
-        "turn_deg_per_cycle: {yaw_left: [[0, 1, 2]]}\n")
+    write_breaststroke_table(tmp_path, stroke.spec_sha256, weights="[0, 0.75, 1.5]", yaw_left="[[0, 1, 2]]")
     with pytest.raises(ConfigError, match="up to weight 1.5.*'steering.max_weight' is 1; run `layered-swim calibrate"):
         load_table(stroke, directory=tmp_path)
     assert weight_grid(1.5) == (0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5) and weight_grid(1.0)[-1] == 1.0
@@ -209,10 +211,8 @@ def test_a_table_calibrated_to_another_max_weight_is_a_clear_error(tmp_path):
 
 def test_a_pace_table_needs_one_value_per_tempo(tmp_path):
     stroke = load_stroke("breaststroke", LAYOUT)
-    (tmp_path / "breaststroke.yaml").write_text(
-        f"stroke: breaststroke\nstroke_sha256: {stroke.spec_sha256}\nweights: [0, 1]\ntempos: [1]\n"
-        "pace: {tempos: [0.5, 1], speed_m_s: [0.3, 1], roll_deg: [0, 0], pitch_deg: [10], depth_m: [0.2, 0.2]}\n"
-        "turn_deg_per_cycle: {yaw_left: [[0, 1]]}\n")
+    write_breaststroke_table(tmp_path, stroke.spec_sha256, pace="{tempos: [0.5, 1], speed_m_s: [0.3, 1], "
+                             "roll_deg: [0, 0], pitch_deg: [10], depth_m: [0.2, 0.2]}")
     with pytest.raises(ConfigError, match="pace"):
         load_table(stroke, directory=tmp_path)
 
