@@ -33,11 +33,10 @@ def still_state(mass_fraction=None) -> BodyState:
                      segments)
 
 
-def table(yaw_turns_deg=(0.0, 2.0, 4.0, 6.0, 8.0)) -> CalibrationTable:
+def table(yaw_turns_deg=(0.0, 2.0, 4.0, 6.0, 8.0), weights=(0.0, 0.25, 0.5, 0.75, 1.0)) -> CalibrationTable:
     turns = np.radians([yaw_turns_deg])
     pace = Pace((0.5, 1.0), (0.4, 0.8), (0.0, 0.0), (0.0, 0.0), (0.2, 0.2))
-    return CalibrationTable("t", "x", (0.0, 0.25, 0.5, 0.75, 1.0), (1.0,), pace,
-                            {"yaw_left": turns, "yaw_right": turns / 2})
+    return CalibrationTable("t", "x", weights, (1.0,), pace, {"yaw_left": turns, "yaw_right": turns / 2})
 
 
 def test_table_inversion():
@@ -328,7 +327,7 @@ def test_lead_looks_further_ahead_where_the_path_bends():
 def test_lead_aims_from_the_swimmers_own_place_on_the_path_when_it_is_ahead():
     line = load_trajectory("straight_line")          # x = 2 + 0.5 t, y = 0, 0.3 m deep
     lead = Lead(straight_s=1.5, bend_s=3.0)
-    aim, ahead_s = lead.aim(line, 0.0, np.array([0.0, 0.5, -0.3]))      # behind: 1.5 s past the target
+    aim, ahead_s = lead.aim(line, 0.0, np.array([0.0, 0.5, -0.3]))      # behind: aims 1.5 s past the target
     # 2 m behind a target that waited at its start before t = 0: as far behind as the search looks.
     assert ahead_s == pytest.approx(-lead.search_s) and aim == pytest.approx([2.75, 0.0, -0.3])
     aim, ahead_s = lead.aim(line, 4.0, np.array([3.0, 0.5, -0.3]))      # 1 m (2 s) behind the target at x = 4
@@ -368,10 +367,7 @@ def test_a_gliding_stroke_near_its_target_glides_only_once_ahead_of_it_along_its
 
 
 def test_weights_above_one_only_for_a_turn_wanted_within_the_strokes_limit():
-    turns = np.radians([[0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0]])
-    pace = Pace((0.5, 1.0), (0.4, 0.8), (0.0, 0.0), (0.0, 0.0), (0.2, 0.2))
-    to_1_5 = CalibrationTable("t", "x", (0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5), (1.0,), pace,
-                              {"yaw_left": turns, "yaw_right": turns})
+    to_1_5 = table((0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0), weights=(0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5))
     gains = SteeringGains(yaw_fraction=1.0, over_weight_within_rad=math.radians(75.0))
     state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
 
