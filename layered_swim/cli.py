@@ -363,11 +363,11 @@ def _validate_sph(args) -> None:
         print(_table([[f"{r['speed_m_s']:g}", f"{r['drag_n']:.1f} +- {r['window_sd_n']:.1f}", f"{r['reference_n']:.1f}",
                        f"{r['ratio']:.3f}"] for r in part["towed_swimmer"]],
                      ["swimmer m/s", "SPH drag N", "Narita 23.5 v^2 N", "ratio"]))
-    print("\ndiagnostic: the broadside plate (shrunk) towed without gravity, so no hydrostatic pressure to lose "
-          "behind it (README, 'SPH backend')")
-    print(_table([[f"{r['speed_m_s']:g}", f"{r['drag_n']:.1f} +- {r['window_sd_n']:.1f}", f"{r['plate_model_n']:.1f}",
-                   _fmt(r["ratio"])] for r in result["broadside_without_gravity"]],
-                 ["speed m/s", "SPH drag N, g = 0", "plate model N", "ratio"]))
+    print("\ndiagnostic: the broadside plate (shrunk) at 0.5 m/s towed deeper in a 1.0 m deep tank: its excess over "
+          "the plate model follows the pressure around it, a share of rho g d A (README, 'SPH backend')")
+    print(_table([[f"{r['depth_m']:g}", f"{r['drag_n']:.1f} +- {r['window_sd_n']:.1f}", f"{r['plate_model_n']:.1f}",
+                   _fmt(r["ratio"]), f"{r['excess_share_of_rho_g_d_a']:.3f}"] for r in result["broadside_by_depth"]],
+                 ["depth m", "SPH drag N", "plate model N", "ratio", "excess / rho g d A"]))
 
 
 def _cmd_bench(args) -> None:

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from layered_swim.analysis.sph_validation import Tank, windowed
+from layered_swim.analysis.sph_validation import Tank, pressure_share, towed_plate, windowed
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError
 from layered_swim.episode import Episode
@@ -82,6 +82,17 @@ def test_held_box_buoyancy_is_rho_g_v_within_30_percent():
     expected = Medium().rho_kg_m3 * 9.81 * 0.3**3
     mean, _ = windowed(lift, settings.time_step_s)
     assert mean > 0 and abs(mean / expected - 1) < 0.3
+
+
+def test_a_towed_plate_resists_the_tow_at_the_depth_asked():
+    row = towed_plate(SphSettings(**COARSE), Medium(), 1.0, 90.0, True, depth_m=0.25)
+    assert row["depth_m"] == 0.25
+    assert 0.0 < row["drag_n"] < 10 * row["plate_model_n"]
+
+
+def test_the_excess_share_is_taken_of_rho_g_d_a():
+    # (40 - 10) N over 1000 * 9.81 * 0.5 m * 0.0625 m^2 = 306.5625 N
+    assert pressure_share(40.0, 10.0, 0.5, 0.0625, 1000.0) == pytest.approx(30.0 / 306.5625)
 
 
 def test_a_short_coupled_swim_stays_finite_and_is_reported():

@@ -5,11 +5,11 @@
   (the project's own plate kernel on the same box at the same velocity).
 - The draft of a free-floating box (density 500 kg/m^3: half its height under water).
 - The towed swimmer's passive drag against Narita et al. 2017's 23.5 v^2 N.
-- A diagnostic, not a correction: the broadside tows again without gravity. The SPH pressure
-  cannot go below zero, so the water parts from a face moving away from it (as if the pool were
-  in vacuum, where real water has the atmosphere pushing it back): the plate's back face loses
-  part of the hydrostatic pressure, a drag that grows with depth, not speed. Without gravity
-  there is no hydrostatic pressure to lose, and what is left is the water's dynamic drag.
+- A diagnostic, not a correction: the broadside plate at 0.5 m/s towed at three depths in a
+  deeper tank. Its excess over the plate model grows with the water pressure around it (a
+  share of rho g d A that stays about the same), not with the flow: a moving box in SPH water
+  meets a drag from the pressure level itself. It is not the free surface (a lid on the water
+  leaves it as it is) and the excess rises further when a lid pressurises the whole tank.
 
 Each case runs without and with the boundary correction (boxes shrunk by ``mesh_shrink_radii``
 particle radii per side: SPH leaves a fluid-free skin about one radius thick on every wall, so
@@ -33,6 +33,7 @@ from layered_swim.fluid.sph.backend import HEADROOM_M, MAX_WATER_SPEED_M_S, boun
 from layered_swim.fluid.sph.worker import SphWorker
 
 WINDOW_S = 0.02
+G_M_S2 = 9.81
 TORSO_HALF_M = np.array([0.15, 0.175, 0.275])       # 0.30 x 0.35 x 0.55 m: pelvis to shoulders
 PLATE_HALF_M = np.array([0.15, 0.15, 0.025])        # 0.30 x 0.30 m, thin along its local z
 FLOAT_HALF_M = np.array([0.15, 0.15, 0.10])         # 0.30 x 0.30 x 0.20 m at 500 kg/m^3: 0.10 m draft
@@ -42,21 +43,25 @@ TOW_ANGLES_DEG = (0.0, 30.0, 60.0, 90.0)
 SWIMMER_SPEEDS_M_S = (1.0, 1.5)
 RAMP_S = 0.1              # tows speed up over this long: an impulsive start throws particles out
 TOW_S = 0.4               # each tow; forces are averaged over its second half
+TOW_TANK_M = (2.2, 1.0, 0.6)                       # length, width, depth: the plate tows
+DEEP_TANK_M = (2.2, 1.6, 1.0)                      # the diagnostic's, deep enough for 0.7 m
+TOW_DEPTH_M = 0.3                                  # the plate's centre below the surface
+DIAGNOSTIC_DEPTHS_M = (0.3, 0.5, 0.7)
+DIAGNOSTIC_SPEED_M_S = 0.5
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 
 class Tank:
     """A rectangular tank of SPH water with boxes in it, driven step by step (no PyBullet)."""
 
-    def __init__(self, settings: SphSettings, medium: Medium, size_m, half_m, pos_m, quat_xyzw, shrink: bool,
-                 gravity_m_s2: float = 9.81):
+    def __init__(self, settings: SphSettings, medium: Medium, size_m, half_m, pos_m, quat_xyzw, shrink: bool):
         self.half_m = boundary_boxes(half_m, settings) if shrink else np.atleast_2d(half_m)
         self.dt = settings.time_step_s
         length, width, depth = size_m
         still = Medium(medium.rho_kg_m3, medium.eta_pa_s, surface_z_m=0.0)
         self.worker = SphWorker(settings.solver_threads)
         self.startup = self.worker.request("start", start_request(
-            settings, still, gravity_m_s2, [-length / 2, -width / 2, -depth], [length / 2, width / 2, HEADROOM_M],
+            settings, still, G_M_S2, [-length / 2, -width / 2, -depth], [length / 2, width / 2, HEADROOM_M],
             self.half_m, pos_m, quat_xyzw))
 
     def step(self, pos_m, quat_xyzw, linvel_m_s) -> np.ndarray:
@@ -89,7 +94,7 @@ def held_box(settings: SphSettings, medium: Medium, centre_z_m: float, shrink: b
     finally:
         tank.close()
     submerged = np.clip(-(centre_z_m - TORSO_HALF_M[2]), 0.0, 2 * TORSO_HALF_M[2])
-    expected = medium.rho_kg_m3 * 9.81 * 4 * TORSO_HALF_M[0] * TORSO_HALF_M[1] * submerged
+    expected = medium.rho_kg_m3 * G_M_S2 * 4 * TORSO_HALF_M[0] * TORSO_HALF_M[1] * submerged
     mean, sd = windowed(lift, tank.dt)
     return {"lift_n": mean, "window_sd_n": sd, "rho_g_v_n": expected, "ratio": mean / expected}
 
@@ -118,20 +123,40 @@ def tow(tank: Tank, start_m: np.ndarray, quat_xyzw: np.ndarray, speed_m_s: float
 
 
 def towed_plate(settings: SphSettings, medium: Medium, speed_m_s: float, angle_deg: float, shrink: bool,
-                gravity_m_s2: float = 9.81) -> dict:
-    """The plate, its face at ``angle_deg`` to the tow (90: broadside), towed along +x at mid-depth."""
+                depth_m: float = TOW_DEPTH_M, tank_m=TOW_TANK_M) -> dict:
+    """The plate, its face at ``angle_deg`` to the tow (90: broadside), its centre ``depth_m``
+    below the surface, towed along +x from 0.5 m off the tank's back wall."""
     half_angle = math.radians(angle_deg) / 2
     quat = np.array([0.0, math.sin(half_angle), 0.0, math.cos(half_angle)])   # about y: local z (the normal) tilts to x
-    depth = 0.3
-    start = np.array([-0.6, 0.0, -depth])
-    tank = Tank(settings, medium, (2.2, 1.0, 0.6), PLATE_HALF_M, start, quat, shrink, gravity_m_s2)
+    start = np.array([-tank_m[0] / 2 + 0.5, 0.0, -depth_m])
+    tank = Tank(settings, medium, tank_m, PLATE_HALF_M, start, quat, shrink)
     try:
         mean, sd = windowed(tow(tank, start, quat, speed_m_s), tank.dt)
     finally:
         tank.close()
     model = plate_model_drag(medium, speed_m_s, quat)
-    return {"speed_m_s": speed_m_s, "angle_deg": angle_deg, "gravity_m_s2": gravity_m_s2, "drag_n": mean, "window_sd_n": sd, "plate_model_n": model,
-            "ratio": mean / model if model > 1e-6 else None}
+    return {"speed_m_s": speed_m_s, "angle_deg": angle_deg, "depth_m": depth_m, "drag_n": mean, "window_sd_n": sd,
+            "plate_model_n": model, "ratio": mean / model if model > 1e-6 else None}
+
+
+def pressure_share(drag_n: float, model_n: float, depth_m: float, face_m2: float, rho_kg_m3: float,
+                   g_m_s2: float = G_M_S2) -> float:
+    """The SPH drag's excess over the plate model as a share of the hydrostatic force on the
+    face (rho g d A): the same share at every depth means the excess follows the pressure level."""
+    return (drag_n - model_n) / (rho_kg_m3 * g_m_s2 * depth_m * face_m2)
+
+
+def broadside_by_depth(settings: SphSettings, medium: Medium) -> list[dict]:
+    """The diagnostic: the shrunk broadside plate at 0.5 m/s at each of DIAGNOSTIC_DEPTHS_M."""
+    half = boundary_boxes(PLATE_HALF_M, settings)[0]
+    face_m2 = 4 * half[0] * half[1]                      # the face the water meets
+    rows = []
+    for depth in DIAGNOSTIC_DEPTHS_M:
+        row = towed_plate(settings, medium, DIAGNOSTIC_SPEED_M_S, 90.0, True, depth, DEEP_TANK_M)
+        row["excess_share_of_rho_g_d_a"] = pressure_share(row["drag_n"], row["plate_model_n"], depth, face_m2,
+                                                          medium.rho_kg_m3)
+        rows.append(row)
+    return rows
 
 
 def floating_box(settings: SphSettings, medium: Medium, shrink: bool, seconds: float = 1.0) -> dict:
@@ -143,7 +168,7 @@ def floating_box(settings: SphSettings, medium: Medium, shrink: bool, seconds: f
     try:
         for _ in range(int(round(seconds / tank.dt))):
             force = tank.step([0.0, 0.0, z], IDENTITY, [0.0, 0.0, v])[2]
-            v += (force / mass - 9.81) * tank.dt       # semi-implicit Euler, vertical only
+            v += (force / mass - G_M_S2) * tank.dt       # semi-implicit Euler, vertical only
             z += v * tank.dt
             heights.append(z)
     finally:
@@ -187,7 +212,6 @@ def validate_sph(settings: SphSettings = SphSettings(), medium: Medium = Medium(
                                      for a in TOW_ANGLES_DEG for v in TOW_SPEEDS_M_S]
         say(f"{label}: towed swimmer")
         out[label]["towed_swimmer"] = [towed_swimmer(settings, medium, v, shrink) for v in SWIMMER_SPEEDS_M_S]
-    say("diagnostic: broadside plate towed without gravity")
-    out["broadside_without_gravity"] = [towed_plate(settings, medium, v, 90.0, True, gravity_m_s2=0.0)
-                                        for v in TOW_SPEEDS_M_S]
+    say("diagnostic: broadside plate towed at three depths")
+    out["broadside_by_depth"] = broadside_by_depth(settings, medium)
     return out
