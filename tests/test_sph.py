@@ -14,7 +14,9 @@ from layered_swim.episode import Episode
 from layered_swim.fluid import FluidError, make_fluid
 from layered_swim.fluid.medium import Medium
 from layered_swim.fluid.sph import SphSettings
-from layered_swim.fluid.sph.scene import box_obj
+from layered_swim.fluid.sph import conveyor
+from layered_swim.fluid.sph.backend import start_request
+from layered_swim.fluid.sph.scene import box_obj, pool_slabs
 from layered_swim.fluid.sph.worker import SphWorker
 
 COARSE = dict(particle_radius_m=0.05, settle_s=0.2, deterministic=True)
@@ -47,9 +49,52 @@ def test_without_the_extra_the_backend_says_how_to_install(monkeypatch):
         make_fluid("sph", load_body(), Medium(), 9.81)
 
 
-def test_the_pool_has_no_current():
-    with pytest.raises(ConfigError, match="no current"):
-        make_fluid("sph", load_body(), Medium(current_m_s=(0.3, 0.0, 0.0)), 9.81)
+def test_an_sph_current_must_be_horizontal():
+    with pytest.raises(ConfigError, match="must be horizontal"):
+        make_fluid("sph", load_body(), Medium(current_m_s=(0.3, 0.0, 0.1)), 9.81)
+    make_fluid("sph", load_body(), Medium(current_m_s=(0.3, -0.2, 0.0)), 9.81)
+
+
+def test_the_conveyor_puts_leaving_water_back_and_drives_the_open_ends():
+    lo, hi = np.array([-1.0, -0.5, -0.5]), np.array([1.0, 0.5, 0.4])
+    x = np.array([[1.02, 0.0, -0.2], [-1.01, 0.6, -0.2], [0.95, 0.0, -0.2], [0.0, 0.45, -0.2], [0.0, 0.0, -0.2]])
+    axes = conveyor.open_axes((0.3, 0.0, 0.0))
+    assert axes == (True, False)
+    conveyor.wrap(x, lo, hi, axes)
+    np.testing.assert_allclose(x[:2, 0], [-0.98, 0.99])        # through x's ends, by the 2 m length
+    assert x[1, 1] == 0.6                                       # y is walled: never moved
+    np.testing.assert_array_equal(conveyor.in_buffers(x, lo, hi, axes, 0.1), [True, True, True, False, False])
+    box_lo, box_hi = conveyor.water_box(lo, hi, (True, True), 0.1)
+    np.testing.assert_allclose(box_lo, [-1.1, -0.6, -0.5])
+    np.testing.assert_allclose(box_hi, [1.1, 0.6, 0.4])
+
+
+def test_an_open_pool_keeps_its_floor_and_the_walls_the_current_does_not_cross():
+    lo, hi = np.array([-1.0, -0.5, -0.5]), np.array([1.0, 0.5, 0.4])
+    floor, *walls = pool_slabs(lo, hi, (True, False), thickness_m=0.1)
+    assert floor[1][2] + floor[0][2] == pytest.approx(-0.5)              # its top is the pool's floor
+    assert [w[1][1] - w[0][1] for w in walls] == pytest.approx([-0.6, 0.5])   # inner faces on y's walls
+    assert all(w[1][0] - w[0][0] < -1.0 and w[1][0] + w[0][0] > 1.0 for w in walls)   # past the open ends
+    assert len(pool_slabs(lo, hi, (True, True))) == 1
+
+
+def test_a_current_runs_through_the_pool_and_keeps_its_water():
+    settings = SphSettings(**COARSE)
+    current = np.array([0.3, 0.0, 0.0])
+    pos, quat = np.array([[0.0, 0.0, 0.3]]), IDENTITY[None]         # a box above the water: water only
+    worker = SphWorker(1)
+    try:
+        worker.request("start", start_request(settings, Medium(current_m_s=tuple(current)), 9.81,
+                                              [-1.5, -0.75, -0.5], [1.5, 0.75, 0.4], [[0.05, 0.05, 0.05]], pos, quat))
+        count = len(worker.request("particles")[0])
+        for _ in range(240):
+            *_, max_speed, escaped = worker.request("step", (pos, quat, np.zeros((1, 3)), np.zeros((1, 3)), False))
+        x, v = worker.request("particles")
+    finally:
+        worker.close()
+    assert len(x) == count and escaped == 0.0 and max_speed < 3.0
+    assert np.all(x[:, 0] > -1.5 - 0.35) and np.all(x[:, 0] < 1.5 + 0.35)    # inside the pool and its buffers
+    np.testing.assert_allclose(v.mean(axis=0), current, atol=0.09)
 
 
 def test_box_mesh_is_closed_with_outward_faces():

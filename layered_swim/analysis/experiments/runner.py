@@ -6,7 +6,7 @@ CSV and report. An experiment module provides
 - ``run(config)``: one simulation, returning a JSON-able result (module level, so it pickles);
 - ``finish(configs, results, out_dir)``: draws the figure, writes the CSV, returns an ``Outcome``;
 - optionally ``BACKENDS``, the fluid backends it makes sense on (the plates only by default: a
-  sweep of minute-long swims would take days in SPH water, and the pool has no current). With
+  sweep of minute-long swims would take days in SPH water). With
   another backend every config carries ``backend`` and ``fluid`` (the backend's settings), which
   ``run`` hands to its episode through ``episode_fluid``.
 """

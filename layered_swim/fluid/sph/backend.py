@@ -18,6 +18,7 @@ from layered_swim.body.model import Body
 from layered_swim.config import ConfigError
 from layered_swim.fluid.backend import FluidBackend, FluidError, FluidWrenches
 from layered_swim.fluid.medium import Medium
+from layered_swim.fluid.sph import conveyor
 from layered_swim.fluid.sph.settings import SphSettings
 from layered_swim.geometry import quat_rotate
 from layered_swim.state import BodyState
@@ -59,8 +60,9 @@ class SphBackend(FluidBackend):
         self.peak_window_force_n = 0.0
 
     def _check_medium(self, medium: Medium) -> None:
-        if any(medium.current_m_s):
-            raise ConfigError("the SPH pool has no current (README, 'SPH backend'); use --backend plate for currents")
+        if medium.current_m_s[2]:
+            raise ConfigError("an SPH pool's current must be horizontal (its z part 0): it flows in through "
+                              "one end of the pool and out through the other")
 
     def set_medium(self, medium: Medium) -> None:
         self._check_medium(medium)
@@ -205,15 +207,21 @@ def boundary_boxes(half_m: np.ndarray, settings: SphSettings) -> np.ndarray:
 
 def start_request(settings: SphSettings, medium: Medium, gravity_m_s2: float, pool_min_m, pool_max_m,
                   boxes_half_m, pos_m, quat_xyzw) -> dict:
-    """The worker's ``start`` request: the scene (pool, water, boxes) and how to settle it."""
+    """The worker's ``start`` request: the scene (pool, water, boxes) and how to settle it. With a
+    current the water reaches a buffer past each end it crosses (``conveyor.py``)."""
     pos, quat = np.array(np.atleast_2d(pos_m), dtype=float), np.array(np.atleast_2d(quat_xyzw), dtype=float)
+    axes = conveyor.open_axes(medium.current_m_s)
+    buffer_m = conveyor.BUFFER_RADII * settings.particle_radius_m
+    water_min, water_max = conveyor.water_box(pool_min_m, pool_max_m, axes, buffer_m)
     return {
-        "scene": {"pool_min_m": np.asarray(pool_min_m, float), "pool_max_m": np.asarray(pool_max_m, float),
+        "scene": {"pool_min_m": water_min, "pool_max_m": water_max,
                   "particle_radius_m": settings.particle_radius_m, "time_step_s": settings.time_step_s,
                   "density_kg_m3": medium.rho_kg_m3, "viscosity_m2_s": kinematic_viscosity(settings, medium),
-                  "gravity_m_s2": gravity_m_s2, "boxes_half_m": np.atleast_2d(boxes_half_m), "box_centres_m": pos},
+                  "gravity_m_s2": gravity_m_s2, "boxes_half_m": np.atleast_2d(boxes_half_m), "box_centres_m": pos,
+                  "open_axes": axes},
         "surface_z_m": medium.surface_z_m, "pos_m": pos, "quat_xyzw": quat, "settle_s": settings.settle_s,
         "damped_share": DAMPED_SHARE, "damping_per_step": DAMPING_PER_STEP,
+        "current_m_s": np.asarray(medium.current_m_s, dtype=float), "buffer_m": buffer_m,
     }
 
 

@@ -1,7 +1,10 @@
 """The SPlisHSPlasH scene for one pool and a set of boxes, written as files (pure: no solver).
 
 One OBJ per box: with one shared OBJ and per-body ``scale``, SPlisHSPlasH 2.19 gave every body
-the container's boundary sampling. Floats are written as plain numbers (its JSON reader rejects
+the container's boundary sampling. The pool's walls come first and the swimmer's boxes last. A
+pool with a current (``conveyor.py``) is open at the ends the current crosses: its floor and
+remaining walls are then static slabs (a container mesh with faces left out let the water fall
+through its floor). Floats are written as plain numbers (its JSON reader rejects
 ``np.float64(...)``). World z is up, as in PyBullet.
 """
 from __future__ import annotations
@@ -11,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+SLAB_M = 0.1               # the open pool's floor and wall thickness
 # Corners and the twelve triangles (outward, counter-clockwise) of the unit cube [-1, 1]^3.
 _CORNERS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
 _TRIANGLES = ((0, 3, 2), (0, 1, 3), (4, 7, 5), (4, 6, 7), (0, 5, 1), (0, 4, 5),
@@ -27,18 +31,25 @@ def box_obj(half_extents_m) -> str:
 
 def write_scene(folder: Path, *, pool_min_m, pool_max_m, fill_top_z_m: float, particle_radius_m: float,
                 time_step_s: float, density_kg_m3: float, viscosity_m2_s: float, gravity_m_s2: float,
-                boxes_half_m, box_centres_m) -> Path:
-    """Write the scene (container, one block of water, one dynamic box per body) into ``folder``
-    and return the scene file. The container is ``pool_min_m``..``pool_max_m`` (its top above the
-    water so a wave stays in); the water block fills it up to ``fill_top_z_m``."""
+                boxes_half_m, box_centres_m, open_axes: tuple[bool, bool] = (False, False)) -> Path:
+    """Write the scene (pool, one block of water, one dynamic box per body) into ``folder`` and
+    return the scene file. The pool is ``pool_min_m``..``pool_max_m`` (its top above the water so
+    a wave stays in), open at both ends of the ``open_axes`` (x, y); the water block fills it up
+    to ``fill_top_z_m``."""
     folder.mkdir(parents=True, exist_ok=True)
     lo, hi = np.asarray(pool_min_m, float), np.asarray(pool_max_m, float)
-    (folder / "pool.obj").write_text(box_obj((hi - lo) / 2))
-    bodies = [{
-        "geometryFile": "pool.obj", "translation": _floats((hi + lo) / 2), "scale": [1.0, 1.0, 1.0],
-        "rotationAxis": [0.0, 0.0, 1.0], "rotationAngle": 0.0, "isDynamic": False, "isWall": True,
-        "mapInvert": True, "samplingMode": 1, "color": [0.1, 0.4, 0.6, 1.0],
-    }]
+    wall = {"scale": [1.0, 1.0, 1.0], "rotationAxis": [0.0, 0.0, 1.0], "rotationAngle": 0.0, "isDynamic": False,
+            "samplingMode": 1, "color": [0.1, 0.4, 0.6, 1.0]}
+    if any(open_axes):
+        bodies = []
+        for k, (half, centre) in enumerate(pool_slabs(lo, hi, open_axes)):
+            (folder / f"wall{k}.obj").write_text(box_obj(half))
+            bodies.append({**wall, "geometryFile": f"wall{k}.obj", "translation": _floats(centre), "isWall": False,
+                           "mapInvert": False})
+    else:
+        (folder / "pool.obj").write_text(box_obj((hi - lo) / 2))
+        bodies = [{**wall, "geometryFile": "pool.obj", "translation": _floats((hi + lo) / 2), "isWall": True,
+                   "mapInvert": True}]
     for k, (half, centre) in enumerate(zip(boxes_half_m, box_centres_m)):
         name = f"box{k:02d}.obj"
         (folder / name).write_text(box_obj(half))
@@ -71,6 +82,25 @@ def write_scene(folder: Path, *, pool_min_m, pool_max_m, fill_top_z_m: float, pa
     path = folder / "scene.json"
     path.write_text(json.dumps(scene, indent=1))
     return path
+
+
+def pool_slabs(lo: np.ndarray, hi: np.ndarray, open_axes: tuple[bool, bool], thickness_m: float = SLAB_M):
+    """The floor and the side walls on the closed axes of an open pool, as (half extents, centre)
+    of static boxes whose inner faces are the pool's; they reach past the open ends."""
+    outer_lo, outer_hi = lo - thickness_m, hi + thickness_m
+    slabs = [(np.array([(outer_hi[0] - outer_lo[0]) / 2, (outer_hi[1] - outer_lo[1]) / 2, thickness_m / 2]),
+              np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2] - thickness_m / 2]))]
+    for axis, is_open in enumerate(open_axes):
+        if is_open:
+            continue
+        half = np.array([(outer_hi[0] - outer_lo[0]) / 2, (outer_hi[1] - outer_lo[1]) / 2,
+                         (hi[2] - outer_lo[2]) / 2])
+        half[axis] = thickness_m / 2
+        for face, sign in ((lo[axis], -1.0), (hi[axis], 1.0)):
+            centre = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (hi[2] + outer_lo[2]) / 2])
+            centre[axis] = face + sign * thickness_m / 2
+            slabs.append((half, centre))
+    return slabs
 
 
 def _floats(values) -> list[float]:

@@ -15,6 +15,7 @@ import time
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from layered_swim.fluid.sph import conveyor
 from layered_swim.geometry import quat_multiply
 
 INSIDE_MARGIN_RADII = 2.0   # particles closer than this to a box are removed (one radius left ~100 m/s jets)
@@ -32,7 +33,8 @@ def import_sph():
 
 
 class SphSolver:
-    """One SPlisHSPlasH scene: the water and ``n`` dynamic boxes (boundary models 1..n; 0 is the pool)."""
+    """One SPlisHSPlasH scene: the water and ``n`` dynamic boxes (the last ``n`` boundary models;
+    the pool's walls come first)."""
 
     def __init__(self, scene_file: str, output_dir: str, half_extents_m: np.ndarray, time_step_s: float,
                  viscosity_m2_s: float, particle_radius_m: float):
@@ -52,7 +54,8 @@ class SphSolver:
         self.dt = float(time_step_s)
         self.half = np.asarray(half_extents_m, dtype=float)
         self.flow_margin_m = 2 * particle_radius_m
-        self.bodies = [sim.getBoundaryModel(k + 1).getRigidBodyObject() for k in range(len(self.half))]
+        first = sim.numberOfBoundaryModels() - len(self.half)
+        self.bodies = [sim.getBoundaryModel(first + k).getRigidBodyObject() for k in range(len(self.half))]
         self.boundary_sim = base.getBoundarySimulator()
         self.mass = np.array([b.getMass() for b in self.bodies])
         # Each body is kept in its principal-axes frame: body rotation = ours * offset^-1, with the
@@ -66,6 +69,17 @@ class SphSolver:
         self._offset_inv, self._inertia_body = np.array(offset_inv), np.array(inertia)
         self.boundary_particles = sum(sim.getBoundaryModel(k).numberOfParticles()
                                       for k in range(sim.numberOfBoundaryModels()))
+        self.current = np.zeros(3)
+        self._conveyor = None
+
+    def set_current(self, current_m_s, water_min_m, water_max_m, buffer_m: float) -> None:
+        """Drive a horizontal current through the pool's open ends (``conveyor.py``). The water's
+        particles are then never re-sorted in memory (SPlisHSPlasH's z-sort would reorder them
+        between our buffer bookkeeping before and after a step)."""
+        self.current = np.asarray(current_m_s, dtype=float)
+        self._conveyor = (np.asarray(water_min_m, float), np.asarray(water_max_m, float),
+                          conveyor.open_axes(current_m_s), buffer_m)
+        self.sim.setValueBool(self.sim.ENABLE_Z_SORT, False)
 
     def _set_viscosity(self, viscosity_m2_s: float) -> None:
         """Set on the model too: the scene file's key for it has moved between releases."""
@@ -156,21 +170,41 @@ class SphSolver:
         np.asarray(self.fluid.getFieldBuffer("position0"))[:count] = kept
         self.fluid.setNumActiveParticles0(count)
         self.fluid.reset()
+        np.asarray(self.fluid.getFieldBuffer("velocity"))[:count] = self.current    # at rest in the current
         return total - count
 
     def damp(self, factor: float) -> None:
-        """Scale every particle's velocity (the settle phase)."""
-        velocity = np.asarray(self.fluid.getFieldBuffer("velocity"))
-        velocity[: self.particles] *= factor
+        """Scale every particle's velocity relative to the current (the settle phase)."""
+        velocity = np.asarray(self.fluid.getFieldBuffer("velocity"))[: self.particles]
+        velocity[:] = self.current + (velocity - self.current) * factor
 
     def step(self, pos_m, quat_xyzw, linvel_m_s, angvel_rad_s) -> tuple[np.ndarray, np.ndarray, float]:
         """Advance the water one step around the boxes at this state. Returns the fluid's force (N)
         and torque (N m, about each box centre) on every box, world frame, and the seconds spent
         inside SPlisHSPlasH's own calls (boundary update, fluid step, force gathering)."""
         solver_s = self.place(pos_m, quat_xyzw, linvel_m_s, angvel_rad_s)
-        solver_s += self._timed(self.sim.getTimeStep().step)
+        if self._conveyor is None:
+            solver_s += self._timed(self.sim.getTimeStep().step)
+        else:
+            solver_s += self._conveyor_step()
         force, torque, gather_s = self._read_wrenches(quat_xyzw)
         return force, torque, solver_s + gather_s
+
+    def _conveyor_step(self) -> float:
+        """One step with the open ends' buffers moved rigidly at the current, and the water that
+        left through one end put back in through the other; the seconds the solver took."""
+        lo, hi, axes, buffer_m = self._conveyor
+        n = self.particles
+        position = np.asarray(self.fluid.getFieldBuffer("position"))[:n]
+        velocity = np.asarray(self.fluid.getFieldBuffer("velocity"))[:n]
+        conveyor.wrap(position, lo, hi, axes)
+        driven = conveyor.in_buffers(position, lo, hi, axes, buffer_m)
+        start = position[driven] + (self.current * self.dt).astype(position.dtype)
+        velocity[driven] = self.current
+        seconds = self._timed(self.sim.getTimeStep().step)
+        position[driven] = start
+        velocity[driven] = self.current
+        return seconds
 
     @staticmethod
     def _timed(call, *args) -> float:

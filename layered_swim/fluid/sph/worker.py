@@ -75,8 +75,8 @@ def _water_check(solver, lo: np.ndarray, hi: np.ndarray) -> tuple[float, float]:
 
 
 def _start(spec: dict, folder: Path, write_scene, solver_class, margin_radii: float):
-    """Build the scene, remove the water inside the boxes, let it settle around them at rest,
-    skim what stands above the surface, and let it settle again."""
+    """Build the scene, remove the water inside the boxes, let it settle around them at rest (or,
+    with a current, flowing at it), skim what stands above the surface, and let it settle again."""
     started = time.perf_counter()
     scene = spec["scene"]
     r, surface = scene["particle_radius_m"], spec["surface_z_m"]
@@ -86,6 +86,8 @@ def _start(spec: dict, folder: Path, write_scene, solver_class, margin_radii: fl
     path = write_scene(folder / "scene", fill_top_z_m=surface + FILL_EXCESS * depth + 2 * r, **scene)
     solver = solver_class(str(path), str(folder / "output"), scene["boxes_half_m"], scene["time_step_s"],
                           scene["viscosity_m2_s"], r)
+    if any(scene["open_axes"]):
+        solver.set_current(spec["current_m_s"], scene["pool_min_m"], scene["pool_max_m"], spec["buffer_m"])
     pos, quat = spec["pos_m"], spec["quat_xyzw"]
     solver.place(pos, quat)
     removed = solver.remove_inside(pos, quat, margin_radii * r)
