@@ -363,6 +363,11 @@ def _validate_sph(args) -> None:
         print(_table([[f"{r['speed_m_s']:g}", f"{r['drag_n']:.1f} +- {r['window_sd_n']:.1f}", f"{r['reference_n']:.1f}",
                        f"{r['ratio']:.3f}"] for r in part["towed_swimmer"]],
                      ["swimmer m/s", "SPH drag N", "Narita 23.5 v^2 N", "ratio"]))
+    flow = result["current"]
+    print(f"\ncurrent {flow[0]['current_m_s'][0]:g} m/s along x through the small pool (no swimmer): the water's mean "
+          "velocity x in the middle, 0.2 m in from every wall")
+    print(_table([[f"{r['time_s']:g}", *(f"{r[layer][0]:.2f}" for layer in ("floor", "middle", "surface"))]
+                  for r in flow], ["s", "near the floor m/s", "mid-depth m/s", "near the surface m/s"]))
     print("\ndiagnostic: the broadside plate (shrunk) at 0.5 m/s towed deeper in a 1.0 m deep tank: its excess over "
           "the plate model follows the pressure around it, a share of rho g d A (README, 'SPH backend')")
     print(_table([[f"{r['depth_m']:g}", f"{r['drag_n']:.1f} +- {r['window_sd_n']:.1f}", f"{r['plate_model_n']:.1f}",

@@ -276,3 +276,26 @@ def test_goal_on_sph_reports_the_plates_beside(monkeypatch, capsys):
     result = json.loads(capsys.readouterr().out)
     assert backends == ["sph", "plate"]
     assert result["pos_m"] == 0.1 and result["plate"] == {"pos_m": 0.2, "prog": 0.5, "dev_m": 0.1, "roll_deg": 0.0}
+
+
+def test_validate_sph_prints_every_case(monkeypatch, capfd):
+    from layered_swim import cli
+    from layered_swim.analysis import sph_validation
+
+    held = {"lift_n": 550.0, "window_sd_n": 3.0, "rho_g_v_n": 565.0, "ratio": 0.97}
+    tow = {"speed_m_s": 0.5, "angle_deg": 90.0, "depth_m": 0.3, "drag_n": 46.5, "window_sd_n": 7.0,
+           "plate_model_n": 13.5, "ratio": 3.44}
+    part = {"held_box_full": held, "held_box_half": held, "towed_plate": [tow],
+            "floating_box": {"draft_m": 0.11, "expected_m": 0.1, "ratio": 1.1},
+            "towed_swimmer": [{"speed_m_s": 1.0, "drag_n": 125.0, "window_sd_n": 8.0, "reference_n": 23.5, "ratio": 5.3}]}
+    layer = [0.51, 0.0, 0.0]
+    result = {"particle_radius_m": 0.05, "mesh_shrink_radii": 1.0, "window_s": 0.02, "before": part, "after": part,
+              "current": [{"time_s": 0.5, "current_m_s": [0.5, 0.0, 0.0], "floor": layer, "middle": layer,
+                           "surface": layer}],
+              "broadside_by_depth": [{**tow, "excess_share_of_rho_g_d_a": 0.149}]}
+    monkeypatch.setattr(sph_validation, "validate_sph", lambda settings, progress=None: result)
+    assert cli.main(["validate", "sph", "--particle-radius", "0.05"]) == 0
+    out = capfd.readouterr().out
+    for heading in ("held box", "floating box", "plate deg", "swimmer m/s", "current 0.5 m/s along x", "excess / rho g d A"):
+        assert heading in out
+    assert "0.51 " in out and "0.149" in out

@@ -5,6 +5,8 @@
   (the project's own plate kernel on the same box at the same velocity).
 - The draft of a free-floating box (density 500 kg/m^3: half its height under water).
 - The towed swimmer's passive drag against Narita et al. 2017's 23.5 v^2 N.
+- A current through the small pool (no swimmer): the water's mean velocity in the middle of the
+  pool, near the floor, at mid-depth and near the surface, every 0.5 s against the current's.
 - A diagnostic, not a correction: the broadside plate at 0.5 m/s towed at three depths in a
   deeper tank. Its excess over the plate model grows with the water pressure around it (a
   share of rho g d A that stays about the same), not with the flow: a moving box in SPH water
@@ -48,21 +50,26 @@ DEEP_TANK_M = (2.2, 1.6, 1.0)                      # the diagnostic's, deep enou
 TOW_DEPTH_M = 0.3                                  # the plate's centre below the surface
 DIAGNOSTIC_DEPTHS_M = (0.3, 0.5, 0.7)
 DIAGNOSTIC_SPEED_M_S = 0.5
+CURRENT_POOL_M = (3.0, 1.5, 0.5)                   # SWIM's small pool
+CURRENT_M_S = (0.5, 0.0, 0.0)
+CURRENT_S = 2.5
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 
 class Tank:
     """A rectangular tank of SPH water with boxes in it, driven step by step (no PyBullet)."""
 
-    def __init__(self, settings: SphSettings, medium: Medium, size_m, half_m, pos_m, quat_xyzw, shrink: bool):
+    def __init__(self, settings: SphSettings, medium: Medium, size_m, half_m, pos_m, quat_xyzw, shrink: bool,
+                 current_m_s=(0.0, 0.0, 0.0)):
         self.half_m = boundary_boxes(half_m, settings) if shrink else np.atleast_2d(half_m)
         self.dt = settings.time_step_s
         length, width, depth = size_m
-        still = Medium(medium.rho_kg_m3, medium.eta_pa_s, surface_z_m=0.0)
+        still = Medium(medium.rho_kg_m3, medium.eta_pa_s, surface_z_m=0.0, current_m_s=tuple(current_m_s))
         self.worker = SphWorker(settings.solver_threads)
         self.startup = self.worker.request("start", start_request(
             settings, still, G_M_S2, [-length / 2, -width / 2, -depth], [length / 2, width / 2, HEADROOM_M],
             self.half_m, pos_m, quat_xyzw))
+        self.size_m = size_m
 
     def step(self, pos_m, quat_xyzw, linvel_m_s) -> np.ndarray:
         """One step with the boxes at this pose and velocity; the total force on them (3,)."""
@@ -159,6 +166,27 @@ def broadside_by_depth(settings: SphSettings, medium: Medium) -> list[dict]:
     return rows
 
 
+def flowing_pool(settings: SphSettings, medium: Medium, current_m_s=CURRENT_M_S, seconds: float = CURRENT_S) -> list[dict]:
+    """The small pool with a current and no swimmer (a small box held above the water): every
+    0.5 s, the water's mean velocity in the middle (0.2 m in from every wall) at three depths."""
+    length, width, depth = CURRENT_POOL_M
+    above = np.array([0.0, 0.0, 0.2])
+    tank = Tank(settings, medium, CURRENT_POOL_M, np.array([0.05, 0.05, 0.05]), above, IDENTITY, False, current_m_s)
+    rows, every = [], int(round(0.5 / tank.dt))
+    try:
+        for k in range(1, int(round(seconds / tank.dt)) + 1):
+            tank.step(above, IDENTITY, np.zeros(3))
+            if k % every == 0:
+                x, v = tank.worker.request("particles")
+                middle = (np.abs(x[:, 0]) < length / 2 - 0.2) & (np.abs(x[:, 1]) < width / 2 - 0.2)
+                layers = {name: v[middle & (np.abs(x[:, 2] - z) < 0.05)].mean(axis=0).tolist()
+                          for name, z in (("floor", 0.1 - depth), ("middle", -depth / 2), ("surface", -0.1))}
+                rows.append({"time_s": round(k * tank.dt, 3), "current_m_s": list(current_m_s), **layers})
+    finally:
+        tank.close()
+    return rows
+
+
 def floating_box(settings: SphSettings, medium: Medium, shrink: bool, seconds: float = 1.0) -> dict:
     """A box of density 500 let go at the surface, free to move vertically: its draft."""
     mass = FLOAT_DENSITY_KG_M3 * float(np.prod(2 * FLOAT_HALF_M))
@@ -212,6 +240,8 @@ def validate_sph(settings: SphSettings = SphSettings(), medium: Medium = Medium(
                                      for a in TOW_ANGLES_DEG for v in TOW_SPEEDS_M_S]
         say(f"{label}: towed swimmer")
         out[label]["towed_swimmer"] = [towed_swimmer(settings, medium, v, shrink) for v in SWIMMER_SPEEDS_M_S]
+    say("current through the small pool")
+    out["current"] = flowing_pool(settings, medium)
     say("diagnostic: broadside plate towed at three depths")
     out["broadside_by_depth"] = broadside_by_depth(settings, medium)
     return out
