@@ -287,7 +287,8 @@ def test_validate_sph_prints_every_case(monkeypatch, capfd):
            "plate_model_n": 13.5, "ratio": 3.44}
     part = {"held_box_full": held, "held_box_half": held, "towed_plate": [tow],
             "floating_box": {"draft_m": 0.11, "expected_m": 0.1, "ratio": 1.1},
-            "towed_swimmer": [{"speed_m_s": 1.0, "drag_n": 125.0, "window_sd_n": 8.0, "reference_n": 23.5, "ratio": 5.3}]}
+            "towed_swimmer": [{"speed_m_s": 1.0, "drag_n": 125.0, "window_sd_n": 8.0, "reference_n": 23.5,
+                               "ratio": 5.3}]}
     layer = [0.51, 0.0, 0.0]
     result = {"particle_radius_m": 0.05, "mesh_shrink_radii": 1.0, "window_s": 0.02, "before": part, "after": part,
               "current": [{"time_s": 0.5, "current_m_s": [0.5, 0.0, 0.0], "floor": layer, "middle": layer,
@@ -296,6 +297,7 @@ def test_validate_sph_prints_every_case(monkeypatch, capfd):
     monkeypatch.setattr(sph_validation, "validate_sph", lambda settings, progress=None: result)
     assert cli.main(["validate", "sph", "--particle-radius", "0.05"]) == 0
     out = capfd.readouterr().out
-    for heading in ("held box", "floating box", "plate deg", "swimmer m/s", "current 0.5 m/s along x", "excess / rho g d A"):
+    for heading in ("held box", "floating box", "plate deg", "swimmer m/s", "current 0.5 m/s along x",
+                    "excess / rho g d A"):
         assert heading in out
     assert "0.51 " in out and "0.149" in out

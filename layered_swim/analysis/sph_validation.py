@@ -53,6 +53,7 @@ DIAGNOSTIC_SPEED_M_S = 0.5
 CURRENT_POOL_M = (3.0, 1.5, 0.5)                   # SWIM's small pool
 CURRENT_M_S = (0.5, 0.0, 0.0)
 CURRENT_S = 2.5
+CURRENT_SAMPLE_S = 0.5
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 
@@ -69,7 +70,6 @@ class Tank:
         self.startup = self.worker.request("start", start_request(
             settings, still, G_M_S2, [-length / 2, -width / 2, -depth], [length / 2, width / 2, HEADROOM_M],
             self.half_m, pos_m, quat_xyzw))
-        self.size_m = size_m
 
     def step(self, pos_m, quat_xyzw, linvel_m_s) -> np.ndarray:
         """One step with the boxes at this pose and velocity; the total force on them (3,)."""
@@ -166,13 +166,15 @@ def broadside_by_depth(settings: SphSettings, medium: Medium) -> list[dict]:
     return rows
 
 
-def flowing_pool(settings: SphSettings, medium: Medium, current_m_s=CURRENT_M_S, seconds: float = CURRENT_S) -> list[dict]:
+def flowing_pool(settings: SphSettings, medium: Medium, current_m_s=CURRENT_M_S,
+                 seconds: float = CURRENT_S) -> list[dict]:
     """The small pool with a current and no swimmer (a small box held above the water): every
-    0.5 s, the water's mean velocity in the middle (0.2 m in from every wall) at three depths."""
+    CURRENT_SAMPLE_S, the water's mean velocity in the middle (0.2 m in from every wall) at
+    three depths."""
     length, width, depth = CURRENT_POOL_M
     above = np.array([0.0, 0.0, 0.2])
     tank = Tank(settings, medium, CURRENT_POOL_M, np.array([0.05, 0.05, 0.05]), above, IDENTITY, False, current_m_s)
-    rows, every = [], int(round(0.5 / tank.dt))
+    rows, every = [], int(round(CURRENT_SAMPLE_S / tank.dt))
     try:
         for k in range(1, int(round(seconds / tank.dt)) + 1):
             tank.step(above, IDENTITY, np.zeros(3))
