@@ -208,7 +208,8 @@ def boundary_boxes(half_m: np.ndarray, settings: SphSettings) -> np.ndarray:
 def start_request(settings: SphSettings, medium: Medium, gravity_m_s2: float, pool_min_m, pool_max_m,
                   boxes_half_m, pos_m, quat_xyzw) -> dict:
     """The worker's ``start`` request: the scene (pool, water, boxes) and how to settle it. With a
-    current the water reaches a buffer past each end it crosses (``conveyor.py``)."""
+    current the water reaches a buffer past each end it crosses and settles at least
+    ``conveyor.SETTLE_S`` (``conveyor.py``)."""
     pos, quat = np.array(np.atleast_2d(pos_m), dtype=float), np.array(np.atleast_2d(quat_xyzw), dtype=float)
     axes = conveyor.open_axes(medium.current_m_s)
     buffer_m = conveyor.BUFFER_RADII * settings.particle_radius_m
@@ -219,7 +220,8 @@ def start_request(settings: SphSettings, medium: Medium, gravity_m_s2: float, po
                   "density_kg_m3": medium.rho_kg_m3, "viscosity_m2_s": kinematic_viscosity(settings, medium),
                   "gravity_m_s2": gravity_m_s2, "boxes_half_m": np.atleast_2d(boxes_half_m), "box_centres_m": pos,
                   "open_axes": axes},
-        "surface_z_m": medium.surface_z_m, "pos_m": pos, "quat_xyzw": quat, "settle_s": settings.settle_s,
+        "surface_z_m": medium.surface_z_m, "pos_m": pos, "quat_xyzw": quat,
+        "settle_s": max(settings.settle_s, conveyor.SETTLE_S) if any(axes) else settings.settle_s,
         "damped_share": DAMPED_SHARE, "damping_per_step": DAMPING_PER_STEP,
         "current_m_s": np.asarray(medium.current_m_s, dtype=float), "buffer_m": buffer_m,
     }

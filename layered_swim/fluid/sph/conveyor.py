@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 BUFFER_RADII = 6            # each open end's rigidly driven water, in particle radii (>= the kernel's reach, 4)
+SETTLE_S = 1.5              # a flowing pool settles at least this long: after 0.5 s its water still surged
+                            # along the pool once (0.39-0.57 m/s for 0.5 m/s over the swim's first 2 s)
 
 
 def open_axes(current_m_s) -> tuple[bool, bool]:
