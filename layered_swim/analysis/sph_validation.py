@@ -65,10 +65,10 @@ class Tank:
         self.half_m = boundary_boxes(half_m, settings) if shrink else np.atleast_2d(half_m)
         self.dt = settings.time_step_s
         length, width, depth = size_m
-        still = Medium(medium.rho_kg_m3, medium.eta_pa_s, surface_z_m=0.0, current_m_s=tuple(current_m_s))
+        water = Medium(medium.rho_kg_m3, medium.eta_pa_s, surface_z_m=0.0, current_m_s=tuple(current_m_s))
         self.worker = SphWorker(settings.solver_threads)
         self.startup = self.worker.request("start", start_request(
-            settings, still, G_M_S2, [-length / 2, -width / 2, -depth], [length / 2, width / 2, HEADROOM_M],
+            settings, water, G_M_S2, [-length / 2, -width / 2, -depth], [length / 2, width / 2, HEADROOM_M],
             self.half_m, pos_m, quat_xyzw))
 
     def step(self, pos_m, quat_xyzw, linvel_m_s) -> np.ndarray:
