@@ -1,74 +1,18 @@
 """``python app.py``: the swimmer chases the point you click on the water, in a real-time 3-D window.
 
-Thin on purpose: it checks the arguments and builds the swim (``layered_swim/render/session.py``)
-before any window opens, so bad input is a one-line error, then hands it to the window
-(``layered_swim/render/window.py``). ``--help`` for the options, H in the window for the keys."""
+A shim: the app is the ``app`` command (``layered_swim/commands/app.py``; also ``layered-swim
+app``), run here as a program of its own. ``--help`` for the options, H in the window for the keys."""
 from __future__ import annotations
 
-import argparse
-import json
-import os
 import sys
-from pathlib import Path
+
+from layered_swim.cli import main as _main
 
 PROG = "app.py"
 
 
-def parser() -> argparse.ArgumentParser:
-    from layered_swim.cli import OneLineParser, steering_options   # argparse only: --help stays fast
-
-    p = OneLineParser(prog=PROG, description="Swim after the mouse (or a trajectory) in a real-time 3-D window.")
-    p.add_argument("--stroke", default="breaststroke",
-                   help="stroke name, path to a stroke .yaml, or auto (chooses and switches strokes; default breaststroke)")
-    p.add_argument("--trajectory", help="a trajectory name or .yaml file: show its path and chase its target")
-    p.add_argument("--backend", default="plate",
-                   help="fluid model; the window runs only plate (SPH is ~20x slower than real time: use `layered-swim render --backend sph`)")
-    steering_options(p)   # --layers (keys toggle them), --current, --density
-    p.add_argument("--policy", metavar="FILE", help="a trained residual (policy.pt from `layered-swim train`) drives "
-                                                     "its stroke (needs the [rl] extra)")
-    p.add_argument("--size", default="1280x720", metavar="WxH", help="window size in pixels")
-    p.add_argument("--capture-dir", default="captures", help="where screenshots and videos go (default captures/)")
-    p.add_argument("--benchmark-frames", type=int, metavar="N",
-                   help="run N frames, print mean FPS and real-time factor as JSON, and exit")
-    return p
-
-
 def main(argv: list[str] | None = None) -> int:
-    args = parser().parse_args(argv)
-    from layered_swim.cli import _guard_stdout, report_errors
-    _guard_stdout()
-    return report_errors(PROG, lambda: _open_window(args))
-
-
-def _open_window(args) -> None:
-    from layered_swim.cli import _size, _vector
-    from layered_swim.config import ConfigError
-    from layered_swim.control.layered import Layers
-    from layered_swim.render.session import SwimSession
-
-    if args.backend != "plate":
-        raise ConfigError(f"the window runs only --backend plate (got {args.backend!r}): SPH water is about 20x slower "
-                          "than real time; watch it with `layered-swim render TRAJECTORY --backend sph --out sph.mp4`")
-    width, height = _size(args.size)
-    if args.benchmark_frames is not None and args.benchmark_frames < 2:
-        raise ConfigError(f"--benchmark-frames must be at least 2, got {args.benchmark_frames}")
-    policy = None
-    if args.policy:
-        from layered_swim.rl.policy import Policy
-
-        policy = Policy.load(args.policy)
-    session = SwimSession(args.stroke, Layers.parse(args.layers), _vector(args.current, "--current"), args.density,
-                          args.trajectory, policy=policy)
-    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-        session.close()
-        raise ConfigError("no display to open a window on (run it on a desktop, or under xvfb-run); "
-                          "`layered-swim render` draws videos without one")
-    from layered_swim.render.window import SwimWindow
-
-    window = SwimWindow(session, width, height, Path(args.capture_dir), args.benchmark_frames)
-    window.run()
-    if window.benchmark is not None:
-        print(json.dumps(window.benchmark))
+    return _main(argv, prog=PROG, command="app")
 
 
 if __name__ == "__main__":

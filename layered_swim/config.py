@@ -6,6 +6,7 @@ expected, so the CLI can print it and exit non-zero instead of showing a traceba
 from __future__ import annotations
 
 import json
+import stat
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
@@ -47,17 +48,46 @@ class Vec3(Strict):
 Model = TypeVar("Model", bound=BaseModel)
 
 
-def read_text(path: str | Path) -> str:
-    """A text file people edit or a run wrote, as UTF-8; any failure is one ConfigError."""
+MAX_TEXT_BYTES = 16 * 2**20      # a stroke, trajectory, config or summary file is kilobytes
+
+
+def check_regular_file(path: str | Path, max_bytes: int) -> Path:
+    """``path`` if it is a regular file of at most ``max_bytes``; else one ConfigError. Checked
+    with stat before any open: opening a FIFO blocks, and /dev/zero never ends."""
     path = Path(path)
     try:
-        return path.read_text(encoding="utf-8")
+        info = path.stat()
     except FileNotFoundError:
         raise ConfigError(f"{path}: file not found") from None
-    except IsADirectoryError:
-        raise ConfigError(f"{path}: is a folder, not a file") from None
     except OSError as err:
         raise ConfigError(f"{path}: cannot read ({err.strerror})") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise ConfigError(f"{path}: is a folder, not a file")
+    if not stat.S_ISREG(info.st_mode):
+        raise ConfigError(f"{path}: not a regular file (a pipe, device or socket); refusing to read it")
+    if info.st_size > max_bytes:
+        raise ConfigError(f"{path}: {info.st_size} bytes, more than the {max_bytes} this file may have")
+    return path
+
+
+def read_bytes(path: str | Path, max_bytes: int = MAX_TEXT_BYTES) -> bytes:
+    """A regular file's bytes, at most ``max_bytes`` (see ``check_regular_file``)."""
+    path = check_regular_file(path, max_bytes)
+    try:
+        with open(path, "rb") as f:
+            data = f.read(max_bytes + 1)     # the file may have grown since the stat
+    except OSError as err:
+        raise ConfigError(f"{path}: cannot read ({err.strerror})") from None
+    if len(data) > max_bytes:
+        raise ConfigError(f"{path}: more than the {max_bytes} bytes this file may have")
+    return data
+
+
+def read_text(path: str | Path, max_bytes: int = MAX_TEXT_BYTES) -> str:
+    """A text file people edit or a run wrote, as UTF-8; any failure is one ConfigError."""
+    data = read_bytes(path, max_bytes)
+    try:
+        return data.decode("utf-8")
     except UnicodeDecodeError as err:
         raise ConfigError(f"{path}: not UTF-8 text (byte {err.start})") from None
 
@@ -98,18 +128,32 @@ def load(model: type[Model], path: str | Path) -> Model:
     return parse(model, load_yaml(path), path)
 
 
-def available_files(directory: Path) -> list[str]:
-    """The bare names of the YAML files shipped in ``directory``."""
-    return sorted(p.stem for p in directory.glob("*.yaml"))
+SHIPPED_DIR = Path(__file__).resolve().parent / "shipped"     # the package's strokes/ and trajectories/
 
 
-def file_path(name_or_path: str | Path, directory: Path, kind: str) -> Path:
+def search_dirs(kind: str) -> tuple[Path, ...]:
+    """Where a bare ``kind`` name (``strokes``, ``trajectories``) is looked up: the working
+    folder's own ``kind/`` first (a user's files), then the ones shipped with the package."""
+    own, shipped = Path(kind), SHIPPED_DIR / kind
+    return (shipped,) if not own.is_dir() or own.resolve() == shipped.resolve() else (own, shipped)
+
+
+def available_files(directories: Path | tuple[Path, ...]) -> list[str]:
+    """The bare names of the YAML files in ``directories``."""
+    directories = (directories,) if isinstance(directories, Path) else directories
+    return sorted({p.stem for directory in directories for p in directory.glob("*.yaml")})
+
+
+def file_path(name_or_path: str | Path, directories: Path | tuple[Path, ...], kind: str) -> Path:
     """A ``kind`` file (stroke, trajectory) by path (anything ending in .yaml/.yml) or by bare
-    name in ``directory``; an unknown name is an error listing the known ones."""
+    name in the first of ``directories`` that has it; an unknown name is an error listing the
+    known ones."""
     candidate = Path(name_or_path)
     if candidate.suffix in (".yaml", ".yml"):
         return candidate
-    path = directory / f"{name_or_path}.yaml"
-    if not path.exists():
-        raise ConfigError(f"unknown {kind} '{name_or_path}' (available: {', '.join(available_files(directory))})")
-    return path
+    directories = (directories,) if isinstance(directories, Path) else directories
+    for directory in directories:
+        path = directory / f"{name_or_path}.yaml"
+        if path.exists():
+            return path
+    raise ConfigError(f"unknown {kind} '{name_or_path}' (available: {', '.join(available_files(directories))})")

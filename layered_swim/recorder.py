@@ -38,7 +38,7 @@ from typing import Iterator, Mapping
 
 import numpy as np
 
-from layered_swim.config import ConfigError
+from layered_swim.config import ConfigError, check_regular_file, load_json
 from layered_swim.outputs import atomic_path
 from layered_swim.tasks.metrics import head_top_height_m
 
@@ -51,6 +51,7 @@ ARRAY_NAMES = ("time_s", "root_pos_m", "root_quat_xyzw", "com_pos_m", "com_vel_m
                "head_top_m")
 OPTIONAL_ARRAY_NAMES = ("joint_work_j",)
 NAME_LISTS = ("segment_names", "joint_names", "pose_names")
+MAX_LOG_BYTES = 2**40     # any real log fits; the check is that it is a regular file (not a pipe or device)
 CSV_COLUMNS = ("time_s", "pelvis_x_m", "pelvis_y_m", "pelvis_z_m", "com_speed_m_s", "head_top_m")
 
 
@@ -176,13 +177,13 @@ class Recorder:
         rows = sum(len(c["time_s"]) for c in chunks(("time_s",)))
         with atomic_path(out_dir / "log.npz") as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as archive:
             for name in logged_names(first):      # one array at a time: each pass reads only it
-                with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
+                with archive.open(_member(name), "w", force_zip64=True) as member:
                     shape = (rows, *first[name].shape[1:])
                     np.lib.format.write_array_header_2_0(member, {"descr": "<f8", "fortran_order": False, "shape": shape})
                     for chunk in chunks((name,)):
                         member.write(np.ascontiguousarray(chunk[name], dtype="<f8").tobytes())
             for name, values in self.names.items():
-                with archive.open(f"{name}.npy", "w") as member:
+                with archive.open(_member(name), "w") as member:
                     np.lib.format.write_array(member, np.array(values))
         with atomic_path(out_dir / "timeseries.csv") as tmp, tmp.open("w") as f:
             f.write(",".join(CSV_COLUMNS) + "\n")
@@ -192,6 +193,13 @@ class Recorder:
                 np.savetxt(f, table, fmt="%.6f", delimiter=",")
         if self._spool is not None:
             shutil.rmtree(self._spool, ignore_errors=True)
+
+
+def _member(name: str) -> zipfile.ZipInfo:
+    """An archive member dated 1980-01-01, not now: the same run gives the same bytes."""
+    info = zipfile.ZipInfo(f"{name}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+    info.compress_type = zipfile.ZIP_DEFLATED
+    return info
 
 
 def logged_names(chunk: Mapping[str, np.ndarray]) -> list[str]:
@@ -218,6 +226,7 @@ def read_log(run_dir: str | Path) -> dict[str, np.ndarray]:
     path, spool = run_dir / "log.npz", run_dir / SPOOL_DIR
     try:
         if path.exists():
+            check_regular_file(path, MAX_LOG_BYTES)
             with np.load(path, allow_pickle=False) as archive:
                 log = {name: archive[name] for name in archive.files}
             log["partial"] = False
@@ -227,7 +236,10 @@ def read_log(run_dir: str | Path) -> dict[str, np.ndarray]:
             if not chunks:
                 raise ValueError("no chunks")
             log = {name: np.concatenate([c[name] for c in chunks]) for name in logged_names(chunks[0])}
-            log.update({k: np.array(v) for k, v in json.loads((spool / "names.json").read_text()).items()})
+            names = load_json(spool / "names.json")
+            if not isinstance(names, dict):
+                raise ConfigError(f"{spool / 'names.json'}: expected the log's name lists, got {type(names).__name__}")
+            log.update({k: np.array(v) for k, v in names.items()})
             log["partial"] = True
         else:
             raise ConfigError(f"{run_dir}: no log.npz (a folder written by `layered-swim run` or `follow --out`)")
@@ -245,6 +257,11 @@ def _check_log(log: dict, path: Path) -> None:
     missing = [name for name in ARRAY_NAMES + NAME_LISTS if name not in log]
     if missing:
         raise ConfigError(f"{path}: not a layered-swim log (no {', '.join(missing)})")
+    for name in NAME_LISTS:
+        names = log[name]
+        if names.ndim != 1 or names.size == 0 or names.dtype.kind != "U":
+            raise ConfigError(f"{path}: {name} must be a non-empty list of names, got shape {names.shape} "
+                              f"({names.dtype})")
     n, segments = len(log["time_s"]), len(log["segment_names"])
     expected = {"time_s": (n,), "root_pos_m": (n, 3), "com_pos_m": (n, 3), "com_vel_m_s": (n, 3),
                 "segment_pos_m": (n, segments, 3), "segment_quat_xyzw": (n, segments, 4),

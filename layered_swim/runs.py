@@ -6,13 +6,16 @@ file), ``goal_run`` is ``goal`` (SWIM's benchmark: one episode reset onto each g
 """
 from __future__ import annotations
 
+import json
 import math
 import os
 import platform
 import resource
+import shutil
 import subprocess
 import sys
 import time
+import warnings
 from dataclasses import asdict
 from importlib import metadata
 from pathlib import Path
@@ -27,7 +30,7 @@ from layered_swim.control.targets import load_trajectory
 from layered_swim.episode import START_JITTER, Episode, StartJitter
 from layered_swim.fluid.medium import Medium, preset
 from layered_swim.fluid.backend import FluidError
-from layered_swim.outputs import COMMAND_KEY, atomic_path, write_json
+from layered_swim.outputs import COMMAND_KEY, OutputFolder, atomic_path, claim, folder_path, write_json
 from layered_swim.recorder import DEFAULT_LOG_HZ, SPOOL_DIR, Recorder
 from layered_swim.sim.simulation import SimulationDiverged
 from layered_swim.tasks import FollowTarget, FreeSwim, GoalReaching, swim_benchmark as bench
@@ -115,23 +118,24 @@ def record(episode: Episode, seconds: float, log_hz: int = DEFAULT_LOG_HZ, progr
 
 
 def run_swim(stroke: str, seconds: float = 30.0, lung_air_l: float | None = None,
-             density: float | None = None, out_dir: str | Path | None = None, seed: int = 0,
+             density: float | None = None, out_dir: OutputFolder | str | Path | None = None, seed: int = 0,
              physics_hz: int = 480, tempo: float = 1.0, fluid: str = "fresh_water",
              log_hz: int = DEFAULT_LOG_HZ, progress: bool = False, backend: str = "plate",
              fluid_settings=None) -> dict:
     """Run ``stroke`` for ``seconds`` and write summary.json, log.npz, timeseries.csv and
-    config.json into ``out_dir`` (default: ``runs/<stroke>-<timestamp>``); returns the summary."""
-    out_dir = Path(out_dir) if out_dir is not None else default_out_dir(stroke)
+    config.json into ``out_dir`` (default: ``runs/<stroke>-<timestamp>``; an ``OutputFolder`` is
+    claimed once everything is checked); returns the summary."""
+    out = out_dir if out_dir is not None else default_out_dir(stroke)
     arguments = {"stroke": stroke, "seconds": seconds, "lung_air_l": lung_air_l, "density": density,
-                 "out_dir": str(out_dir), "seed": seed, "physics_hz": physics_hz, "tempo": tempo,
+                 "out_dir": str(folder_path(out)), "seed": seed, "physics_hz": physics_hz, "tempo": tempo,
                  "fluid": fluid, "log_hz": log_hz, "backend": backend}
     check_seconds(seconds)
-    out_dir.mkdir(parents=True, exist_ok=True)
     if seconds > WARM_UP_AFTER_S:
         warm_compiled_kernels(stroke)
     episode = Episode(stroke, FreeSwim(sample_hz=log_hz), medium=make_medium(fluid, density), backend=backend,
                       fluid_settings=fluid_settings, lung_air_l=lung_air_l, physics_hz=physics_hz, tempo=tempo,
                       seed=seed)
+    out_dir = _claim(out, episode)
     write_json(out_dir / "config.json", resolved_config(episode, arguments, log_hz, "run"))
     return logged_swim(episode, seconds, out_dir, log_hz, progress)
 
@@ -141,10 +145,12 @@ def logged_swim(episode: Episode, seconds: float, out_dir: Path, log_hz: int = D
     """``swim`` with its log streamed into ``out_dir`` (flat memory for any length); writes
     ``log.npz``, ``timeseries.csv`` and ``summary.json`` (``extra`` first, then the task's
     metrics, the fluid's report and ``report()``) and returns the summary. A run stopped early
-    (Ctrl-C, a blow-up) saves what it logged, marked ``partial`` in its summary, then stops the
-    caller too."""
+    (Ctrl-C, a blow-up, a dead solver) saves what it logged and its summary, marked ``partial``,
+    then stops the caller too, its message naming ``out_dir``. A write that fails (a full disk) is
+    one OSError naming the file and where the log so far is kept."""
+    spool = out_dir / SPOOL_DIR
     try:
-        recorder = Recorder(episode.sim, log_hz, joint_work=True, spool_dir=out_dir / SPOOL_DIR)
+        recorder = Recorder(episode.sim, log_hz, joint_work=True, spool_dir=spool)
     except BaseException:
         episode.close()
         raise
@@ -153,17 +159,52 @@ def logged_swim(episode: Episode, seconds: float, out_dir: Path, log_hz: int = D
         swim(episode, seconds, [recorder, *observers], progress)
     except (KeyboardInterrupt, SimulationDiverged, FluidError) as err:
         stopped = err
+    except OSError as err:      # a chunk not written: the ones before it stay in the spool
+        raise _unwritten(err, err.filename, _spool_kept(recorder, spool)) from None
     result = {**(extra or {}), **_metrics(episode, stopped), **fluid_report(episode), **(report() if report else {})}
     if stopped is not None:
-        reason = "interrupted" if isinstance(stopped, KeyboardInterrupt) else " ".join(str(stopped).split())
+        interrupted = isinstance(stopped, KeyboardInterrupt)
+        reason = "interrupted" if interrupted else " ".join(str(stopped).split())
         result["partial"] = {"stopped_at_s": episode.time_s, "of_s": seconds, "reason": reason}
-        if recorder.empty:
-            raise stopped
-    recorder.save(out_dir)
-    write_json(out_dir / "summary.json", result)
+        if not interrupted:     # the one line the user reads says where the run so far is
+            stopped.args = (f"{reason}; the run so far is saved in {out_dir}",)
+    _save(recorder, out_dir, result, nothing_logged=stopped is not None and recorder.empty)
     if stopped is not None:
         raise stopped
     return result
+
+
+def _save(recorder: Recorder, out_dir: Path, result: dict, nothing_logged: bool) -> None:
+    """``logged_swim``'s log, then summary.json; with nothing logged, no log and no spool (it
+    would hold only the names)."""
+    spool, summary = out_dir / SPOOL_DIR, out_dir / "summary.json"
+    kept = None
+    if nothing_logged:
+        shutil.rmtree(spool)
+    else:
+        try:
+            recorder.save(out_dir)
+        except OSError as err:      # the spool goes only once log.npz and timeseries.csv are whole
+            raise _unwritten(err, err.filename, _spool_kept(recorder, spool)) from None
+        kept = out_dir / "log.npz"
+    try:
+        write_json(summary, result)
+    except OSError as err:
+        raise _unwritten(err, summary, kept) from None
+
+
+def _spool_kept(recorder: Recorder, spool: Path) -> Path | None:
+    """``spool`` once a chunk has reached it; before that it holds only the names, and goes."""
+    if recorder.n_chunks:
+        return spool
+    shutil.rmtree(spool, ignore_errors=True)    # tidying up must not hide the error being reported
+    return None
+
+
+def _unwritten(err: OSError, path, kept: Path | None) -> OSError:
+    """A failed write (a full disk) as one line: the file, and where the log so far is kept."""
+    where = f"the log so far is kept in {kept}" if kept else "no log is kept"
+    return OSError(err.errno, f"{err.strerror}; {where}", path)
 
 
 WARM_UP_AFTER_S = 600.0     # runs longer than this have the numba kernels compiled in a child first
@@ -196,7 +237,7 @@ def rss_mb() -> float:
         return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
-def soak(hours: float, stroke: str, out_dir: Path, progress: bool = False) -> dict:
+def soak(hours: float, stroke: str, out_dir: OutputFolder | Path, progress: bool = False) -> dict:
     """Swim ``hours`` of simulated time with the log streaming into ``out_dir``, sampling memory
     every ``SOAK_SAMPLE_S``; the summary adds RSS at the start of the counted stretch, at the end
     and at peak, the growth over the stretch, and whether everything stayed finite."""
@@ -205,6 +246,7 @@ def soak(hours: float, stroke: str, out_dir: Path, progress: bool = False) -> di
     seconds = hours * 3600.0
     warm_compiled_kernels(stroke)
     episode = Episode(stroke, FreeSwim(sample_hz=DEFAULT_LOG_HZ))
+    out_dir = _claim(out_dir, episode)
     write_json(out_dir / "config.json", resolved_config(episode, {"hours": hours, "stroke": stroke,
                                                                   "out_dir": str(out_dir)}, DEFAULT_LOG_HZ, "soak"))
     every = int(round(SOAK_SAMPLE_S * episode.sim.config.physics_hz))
@@ -229,17 +271,22 @@ def soak(hours: float, stroke: str, out_dir: Path, progress: bool = False) -> di
 
 
 def _metrics(episode: Episode, stopped: BaseException | None) -> dict:
-    """The task's metrics; a run stopped too early to have them gets none rather than a second error."""
-    try:
+    """The task's metrics; a run stopped too early to have them gets none rather than a second
+    error, numpy's warnings about empty data or NaNs that summary.json cannot hold."""
+    if stopped is None:
         return episode.metrics()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)     # means of no or one sample: NaN, refused below
+            metrics = episode.metrics()
+        json.dumps(metrics, allow_nan=False)
     except (ValueError, IndexError, ZeroDivisionError, ConfigError):
-        if stopped is None:
-            raise
         return {}
+    return metrics
 
 
 def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = Layers(), current=(0.0, 0.0, 0.0),
-               density: float | None = None, seconds: float = 60.0, out_dir: str | Path | None = None,
+               density: float | None = None, seconds: float = 60.0, out_dir: OutputFolder | str | Path | None = None,
                backend: str = "plate", fluid_settings=None, wrap=None, driver=None, extra: dict | None = None,
                seed: int = 0, jitter: StartJitter = START_JITTER) -> dict:
     """Follow ``trajectory``. ``wrap`` and ``driver`` put something else in charge of the
@@ -257,8 +304,7 @@ def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = L
     if out_dir is None:
         swim(episode, seconds, observers)
         return {**head, **episode.metrics(), **fluid_report(episode)}
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = _claim(out_dir, episode)
     write_json(out / "config.json", {COMMAND_KEY: "follow", "trajectory": str(target.source),
                                      "trajectory_spec": _dump(target.spec), "stroke": stroke,
                                      "layers": layers.describe(), "current_m_s": list(current),
@@ -339,6 +385,16 @@ def check_path_in_pool(episode: Episode, target, seconds: float) -> None:
         raise ConfigError(f"the target leaves the {hi[0] - lo[0]:g} x {hi[1] - lo[1]:g} m SPH pool at t = {t:.1f} s "
                           f"(at x = {path[outside][0][0]:.2f}, y = {path[outside][0][1]:.2f} m); "
                           "use --pool large, fewer --seconds or --backend plate")
+
+
+def _claim(out: OutputFolder | str | Path, episode: Episode) -> Path:
+    """The output folder claimed now that the episode (stroke, files, settings) is built: a
+    command refused before this point has touched nothing. The episode is closed if it fails."""
+    try:
+        return claim(out)
+    except BaseException:
+        episode.close()
+        raise
 
 
 def check_seconds(seconds: float) -> None:

@@ -45,7 +45,7 @@ def test_control_never_imports_the_simulation():
 
 
 def test_rooms_import_only_downward():
-    """Arrows run one way: cli/app -> analysis, render -> episode -> tasks, control, sim -> fluid,
+    """Arrows run one way: cli/app -> commands -> analysis, render -> episode -> tasks, control, sim -> fluid,
     body -> state, geometry, outputs, config. (Listed: what each room may import besides itself.)"""
     base = {"config", "geometry", "state", "outputs"}
     allowed = {
@@ -61,6 +61,18 @@ def test_rooms_import_only_downward():
 
     offenders = {(m, d) for m, deps in GRAPH.items() if room(m) in allowed
                  for d in deps if room(d) != room(m) and room(d) not in allowed[room(m)]}
+    assert not offenders
+
+
+def test_only_the_cli_imports_the_commands():
+    """layered_swim/commands/ (one module per command) sits right under cli.py: nothing else imports
+    it, and it never imports cli.py back (app.py reaches the app command through cli.main)."""
+    def room(module: str) -> str:
+        return module.split(".")[1] if "." in module else module
+
+    offenders = {(m, d) for m, deps in GRAPH.items() for d in deps
+                 if room(d) == "commands" and room(m) not in ("commands", "cli")}
+    offenders |= {(m, d) for m, deps in GRAPH.items() if room(m) == "commands" for d in deps if room(d) == "cli"}
     assert not offenders
 
 

@@ -1,4 +1,5 @@
 """The console script, run as a subprocess the way people run it."""
+import importlib
 import json
 import os
 import subprocess
@@ -58,7 +59,8 @@ def test_run_json(tmp_path):
     assert SUMMARY_KEYS <= set(summary)
     assert summary["stroke"] == "rest" and summary["seconds"] == pytest.approx(2.0)
     assert "settle" in summary["note"]
-    assert {p.name for p in out.iterdir()} == {"summary.json", "config.json", "log.npz", "timeseries.csv"}
+    assert {p.name for p in out.iterdir()} == {"summary.json", "config.json", "log.npz", "timeseries.csv",
+                                               ".layered-swim-output", ".layered-swim.lock"}
     config = json.loads((out / "config.json").read_text())
     assert config["arguments"]["seconds"] == 2.0 and config["stroke"]["name"] == "rest"
     assert config["medium"]["rho_kg_m3"] > 0 and config["physics_hz"] == 480
@@ -92,3 +94,37 @@ def test_validate_drag_json():
         row = rows[speed]
         assert row["reference_n"] == pytest.approx(23.5 * speed**2)
         assert 0.8 < row["drag_n"] / row["reference_n"] < 1.2
+
+
+
+def test_app_is_a_command_too():
+    """`layered-swim app` is what `python app.py` opens: the same options, the same help."""
+    result = cli("app", "--help")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("usage: layered-swim app ") and "--stroke" in result.stdout
+    shim = subprocess.run([sys.executable, str(REPO / "app.py"), "--help"], cwd=REPO, capture_output=True, text=True,
+                          timeout=60)
+    assert shim.returncode == 0 and shim.stdout.startswith("usage: app.py ")
+    assert shim.stdout.split("\noptions:")[1] == result.stdout.split("\noptions:")[1]
+
+
+def test_every_command_is_a_module_and_the_cli_only_puts_them_together():
+    import layered_swim.commands as package
+    from layered_swim import cli
+
+    names = {p.stem for p in Path(package.__file__).parent.glob("*.py")} - {"__init__", "options", "tables"}
+    assert names == set(cli.COMMANDS)
+    for name in names:
+        module = importlib.import_module(f"layered_swim.commands.{name}")
+        assert callable(module.add_parser) and callable(module.run), name
+    assert len((REPO / "layered_swim" / "cli.py").read_text().splitlines()) <= 150
+
+
+def test_help_loads_no_heavy_module():
+    """--help stays fast: PyBullet and torch load only inside a command's run()."""
+    for program in (["-m", "layered_swim"], [str(REPO / "app.py")]):
+        result = subprocess.run([sys.executable, "-X", "importtime", *program, "--help"], cwd=REPO,
+                                capture_output=True, text=True, timeout=60)
+        assert result.returncode == 0, result.stderr
+        imported = {line.split("|")[-1].strip().split(".")[0] for line in result.stderr.splitlines() if "|" in line}
+        assert not imported & {"pybullet", "torch", "numpy"}, program

@@ -231,8 +231,8 @@ def test_short_follow_gets_closer_to_a_fixed_target():
 @pytest.mark.parametrize("stroke_name, axes", [
     ("breaststroke", ("yaw", "pitch", "roll")), ("front_crawl", ("yaw", "pitch", "roll")),
     ("treading_water", ("yaw", "pitch", "roll")),
-    # Their pitch and roll sequences do not yet turn them monotonically at every tempo (README
-    # "Status and known gaps"); their steering corrects the heading only.
+    # Their pitch and roll sequences do not yet turn them monotonically at every tempo
+    # (docs/limitations.md); their steering corrects the heading only.
     ("backstroke", ("yaw",)), ("butterfly", ("yaw",))])
 def test_shipped_calibration_is_fresh_and_every_sequence_turns_monotonically(stroke_name, axes):
     """Yang Fig. 11: more weight, more turn, for every sequence of the axes given, at every tempo,

@@ -10,9 +10,8 @@ import numpy as np
 import pytest
 import yaml
 
-from layered_swim.config import ConfigError
 from layered_swim.episode import Episode
-from layered_swim.outputs import atomic_path, prepare_out_dir
+from layered_swim.outputs import atomic_path
 from layered_swim.recorder import CHUNK_ROWS, read_log
 from layered_swim.control.stroke import STROKES_DIR
 from layered_swim.control.targets import TRAJECTORIES_DIR
@@ -53,21 +52,6 @@ def test_an_unwritable_out_fails_before_simulating():
     started = time.perf_counter()
     assert_one_line_error(cli("run", "--stroke", "breaststroke", "--out", "/proc/nope/x"), "/proc/nope")
     assert time.perf_counter() - started < 10      # the 30 s swim never ran (2 s plus interpreter start)
-
-
-def test_an_out_folder_of_another_command_is_refused_unless_overwrite(tmp_path):
-    out = prepare_out_dir(tmp_path / "r", "run")
-    (out / "config.json").write_text(json.dumps({"command": "run"}))
-    (out / "log.npz").write_text("old")
-    assert prepare_out_dir(out, "run") == out                      # the same command again: fine
-    with pytest.raises(ConfigError, match="holds the output of `run`.*--overwrite"):
-        prepare_out_dir(out, "analyze")
-    prepare_out_dir(out, "analyze", overwrite=True)
-    assert list(out.iterdir()) == []                              # nothing of the old run stays beside
-    (out / "notes.txt").write_text("mine")
-    with pytest.raises(ConfigError, match="not a layered-swim output"):
-        prepare_out_dir(out, "run")
-    assert_one_line_error(cli("follow", "straight_line", "--seconds", "1", "--out", str(out)), "--overwrite")
 
 
 def test_a_failed_write_leaves_nothing_half_written(tmp_path):

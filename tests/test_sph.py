@@ -271,6 +271,7 @@ def test_the_pool_floor_holds_the_swimmer_and_a_deep_start_pose_is_raised_above_
 def test_goal_on_sph_reports_the_plates_beside(monkeypatch, capsys):
     import layered_swim.cli as cli
     import layered_swim.runs as runs
+    from layered_swim.commands import goal
 
     backends = []
 
@@ -281,7 +282,7 @@ def test_goal_on_sph_reports_the_plates_beside(monkeypatch, capsys):
                 "goals": [{"goal_m": [1.5, 0.0, -0.05], "pos_m": pos, "prog": 0.5, "dev_m": 0.1, "roll_deg": 0.0}]}
 
     monkeypatch.setattr(runs, "goal_run", goal_run)
-    cli._cmd_goal(cli._parser().parse_args(["goal", "--backend", "sph", "--json"]))
+    goal.run(cli._parser().parse_args(["goal", "--backend", "sph", "--json"]))
     result = json.loads(capsys.readouterr().out)
     assert backends == ["sph", "plate"]
     assert result["pos_m"] == 0.1 and result["plate"] == {"pos_m": 0.2, "prog": 0.5, "dev_m": 0.1, "roll_deg": 0.0}

@@ -16,8 +16,8 @@ from layered_swim.analysis.sweep import run_sweep
 from layered_swim.config import ConfigError
 from layered_swim.control.layered import Layers
 from layered_swim.episode import WIDE_JITTER
-from layered_swim.outputs import COMMAND_KEY, write_json
-from layered_swim.runs import check_seconds, follow_run, versions
+from layered_swim.outputs import COMMAND_KEY, OutputFolder, claim, write_json
+from layered_swim.runs import MIN_SECONDS, check_seconds, follow_run, versions
 
 HEADLINES = ("mean_distance_m", "max_distance_m", "final_distance_m", "mean_heading_error_deg",
              "hold_depth_error_m", "hold_depth_error_max_m", "worst_reach_s", "worst_held_within_m")
@@ -48,8 +48,8 @@ def spread(values: list) -> dict | None:
 
 
 def follow_seeds(trajectory: str, stroke: str, layers: Layers, current=(0.0, 0.0, 0.0), density: float | None = None,
-                 seconds: float = 60.0, seeds: int = 10, out_dir: str | Path | None = None, workers: int = 2,
-                 progress: bool = False, policy: str | None = None) -> dict:
+                 seconds: float = 60.0, seeds: int = 10, out_dir: OutputFolder | str | Path | None = None,
+                 workers: int = 2, progress: bool = False, policy: str | None = None) -> dict:
     """``policy``: a trained residual (its file) drives its own reference controller instead."""
     check_seconds(seconds)
     if not 1 <= seeds <= MAX_SEEDS:
@@ -57,15 +57,17 @@ def follow_seeds(trajectory: str, stroke: str, layers: Layers, current=(0.0, 0.0
     common = {"trajectory": trajectory, "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
               "density_kg_m3": density, "seconds": seconds, **({"policy": str(policy)} if policy else {})}
     configs = [{**common, "seed": seed} for seed in range(1, seeds + 1)]
+    out = None
+    if out_dir is not None:       # the first start checked here (files, stroke, path), then the folder claimed
+        follow_run(trajectory, stroke, layers, current, density, min(seconds, MIN_SECONDS))
+        out = claim(out_dir)
     runs = run_sweep(follow_one, configs, None, workers, progress, desc="starts")
     summary = {**common, "seeds": seeds, "start_jitter": asdict(WIDE_JITTER),
                "median": {k: s for k in HEADLINES if (s := spread([r.get(k) for r in runs])) is not None},
                "runs": runs}
     if any("reached_all" in r for r in runs):
         summary["reached_all_share"] = float(np.mean([bool(r.get("reached_all")) for r in runs]))
-    if out_dir is not None:
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
+    if out is not None:
         write_json(out / "config.json", {COMMAND_KEY: "follow", **common, "seeds": seeds,
                                          "start_jitter": asdict(WIDE_JITTER), "versions": versions()})
         write_json(out / "summary.json", summary)

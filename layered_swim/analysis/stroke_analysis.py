@@ -22,7 +22,7 @@ from layered_swim.control.stroke import stroke_path
 from layered_swim.episode import Episode
 from layered_swim.fluid import make_fluid
 from layered_swim.fluid.sph import SphSettings
-from layered_swim.outputs import COMMAND_KEY, write_json, write_text
+from layered_swim.outputs import COMMAND_KEY, OutputFolder, claim, write_json, write_text
 from layered_swim.recorder import logged_names, read_log
 from layered_swim.runs import check_seconds, make_medium, record, resolved_config
 
@@ -44,11 +44,20 @@ def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | N
             "settle_s": float(settle_s), "seed": seed, "physics_hz": physics_hz, "backend": backend, "sph": sph}
 
 
-def analyze_stroke(config: dict, progress: bool = False) -> dict:
+def analysis_episode(config: dict) -> Episode:
+    """The episode ``config`` swims; building it checks every file and setting of the config."""
     medium = make_medium(config["fluid"], config["density_kg_m3"], config["current_m_s"])
-    settings = SphSettings(**config["sph"]) if config.get("sph") else None
-    episode = Episode(config["stroke"], medium=medium, physics_hz=config["physics_hz"], seed=config["seed"],
-                      backend=config.get("backend", "plate"), fluid_settings=settings)
+    return Episode(config["stroke"], medium=medium, physics_hz=config["physics_hz"], seed=config["seed"],
+                   backend=config.get("backend", "plate"), fluid_settings=_sph_settings(config))
+
+
+def _sph_settings(config: dict) -> SphSettings | None:
+    return SphSettings(**config["sph"]) if config.get("sph") else None
+
+
+def analyze_stroke(config: dict, progress: bool = False) -> dict:
+    episode = analysis_episode(config)
+    settings = _sph_settings(config)
     sim, stroke = episode.sim, episode.stroke
     recorder = record(episode, config["seconds"], ANALYSIS_LOG_HZ, progress, joint_work=True)
     posture = stroke.start.posture
@@ -116,10 +125,9 @@ def comparisons(result: dict) -> list[dict]:
     return rows
 
 
-def write_analysis(result: dict, out_dir: str | Path) -> list[str]:
+def write_analysis(result: dict, out_dir: OutputFolder | str | Path) -> list[str]:
     """Write every output file of one analysis into ``out_dir``; returns their names."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(out_dir)
     table = comparisons(result)
     write_json(out / "summary.json", {"stroke": result["stroke"], "posture": result["posture"],
                                        **result["summary"], "comparison": table})
@@ -137,10 +145,11 @@ def write_analysis(result: dict, out_dir: str | Path) -> list[str]:
     return ["summary.json", "config.json", "cycles.csv", "profiles.csv", *PLOTS, "report.md"]
 
 
-def write_comparison(configs: list[dict], out_dir: str | Path, workers: int = 2, progress: bool = False) -> list[dict]:
+def write_comparison(configs: list[dict], out_dir: OutputFolder | str | Path, workers: int = 2,
+                     progress: bool = False) -> list[dict]:
     """Analyze every configuration (in parallel, cached under ``out_dir/cache``), write each
     stroke's full outputs into ``out_dir/<stroke>/`` and the side-by-side report."""
-    out = Path(out_dir)
+    out = claim(out_dir)
     results = run_sweep(analyze_stroke, configs, out / "cache", workers, progress, desc="strokes")
     tables = []
     for result in results:

@@ -19,6 +19,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Callable
 
+from layered_swim.config import ConfigError, read_bytes, read_text
 from layered_swim.outputs import write_text
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
@@ -49,7 +50,7 @@ def _presentation_or_task(relative: str) -> bool:
 
 
 def file_sha256(path: str | Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    return hashlib.sha256(read_bytes(path)).hexdigest()
 
 
 def cache_key(task: Callable, config: dict) -> str:
@@ -62,8 +63,8 @@ def cache_key(task: Callable, config: dict) -> str:
 
 def _load(path: Path):
     try:
-        return json.loads(path.read_text())["result"]
-    except (OSError, ValueError, KeyError):
+        return json.loads(read_text(path))["result"]
+    except (ConfigError, ValueError, KeyError, TypeError):
         return None    # missing or half-written: compute it again
 
 

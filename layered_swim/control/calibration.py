@@ -17,10 +17,9 @@ import yaml
 from pydantic import Field, model_validator
 
 from layered_swim.config import ConfigError, Degrees, Strict, between, load
-from layered_swim.control.stroke import STROKES_DIR, Sequence, Stroke
+from layered_swim.control.stroke import Sequence, Stroke
 from layered_swim.outputs import write_text
 
-CALIBRATION_DIR = STROKES_DIR / "calibration"
 SEQUENCE_AXIS = {"yaw_left": ("yaw", 1.0), "yaw_right": ("yaw", -1.0), "pitch_up": ("pitch", 1.0),
                  "pitch_down": ("pitch", -1.0), "roll_left": ("roll", 1.0), "roll_right": ("roll", -1.0)}
 
@@ -135,8 +134,9 @@ class CalibrationTable:
         return out
 
 
-def calibration_path(stroke_name: str, directory: Path = CALIBRATION_DIR) -> Path:
-    return directory / f"{stroke_name}.yaml"
+def calibration_path(stroke: Stroke, directory: Path | None = None) -> Path:
+    """A stroke's table: ``calibration/<name>.yaml`` beside its stroke file, unless ``directory``."""
+    return (directory or Path(stroke.source).parent / "calibration") / f"{stroke.name}.yaml"
 
 
 def save_table(table: CalibrationTable, path: Path) -> Path:
@@ -159,8 +159,8 @@ def save_table(table: CalibrationTable, path: Path) -> Path:
     return path
 
 
-def load_table(stroke: Stroke, directory: Path = CALIBRATION_DIR) -> CalibrationTable:
-    path = calibration_path(stroke.name, directory)
+def load_table(stroke: Stroke, directory: Path | None = None) -> CalibrationTable:
+    path = calibration_path(stroke, directory)
     remake = f"run `layered-swim calibrate --stroke {stroke.name}`"
     if not path.exists():
         raise CalibrationError(f"{path}: no calibration table for stroke '{stroke.name}'; {remake}")

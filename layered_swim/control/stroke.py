@@ -18,12 +18,12 @@ import numpy as np
 from pydantic import Field, model_validator
 from scipy.interpolate import PchipInterpolator
 
-from layered_swim.config import ConfigError, Degrees, Strict, available_files, between, file_path, load
+from layered_swim.config import SHIPPED_DIR, ConfigError, Degrees, Strict, available_files, between, file_path, load, search_dirs
 from layered_swim.control.steering import SteeringGains
 from layered_swim.geometry import ease
 from layered_swim.state import JointLayout, Start
 
-STROKES_DIR = Path(__file__).resolve().parents[2] / "strokes"
+STROKES_DIR = SHIPPED_DIR / "strokes"      # the top-level strokes/ in a checkout
 TABLE_SAMPLES = 1024
 
 
@@ -340,14 +340,14 @@ def _coord(layout: JointLayout, joints: set[str], joint: str, axis: str, where: 
         raise ConfigError(f"{where}: joint '{joint}' has no axis '{axis}' (axes: {', '.join(axes)})") from None
 
 
-def available_strokes(directory: Path = STROKES_DIR) -> list[str]:
-    return available_files(directory)
+def available_strokes(directory: Path | None = None) -> list[str]:
+    return available_files(directory or search_dirs("strokes"))
 
 
-def stroke_path(name_or_path: str, directory: Path = STROKES_DIR) -> Path:
-    return file_path(name_or_path, directory, "stroke")
+def stroke_path(name_or_path: str, directory: Path | None = None) -> Path:
+    return file_path(name_or_path, directory or search_dirs("strokes"), "stroke")
 
 
-def load_stroke(name_or_path: str, layout: JointLayout, directory: Path = STROKES_DIR) -> Stroke:
+def load_stroke(name_or_path: str, layout: JointLayout, directory: Path | None = None) -> Stroke:
     path = stroke_path(name_or_path, directory)
     return build_stroke(load(StrokeSpec, path), layout, str(path))

@@ -22,9 +22,10 @@ from typing import Any, Literal, Protocol, runtime_checkable
 import numpy as np
 from pydantic import Field
 
-from layered_swim.config import ConfigError, Coordinate_m, Strict, available_files, between, file_path, load_yaml, parse
+from layered_swim.config import (SHIPPED_DIR, ConfigError, Coordinate_m, Strict, available_files, between, file_path,
+                                 load_yaml, parse, search_dirs)
 
-TRAJECTORIES_DIR = Path(__file__).resolve().parents[2] / "trajectories"
+TRAJECTORIES_DIR = SHIPPED_DIR / "trajectories"     # the top-level trajectories/ in a checkout
 CURVE_SAMPLES = 4096          # samples per closed curve (figure eight, circle)
 MAX_SAMPLES = 200_000
 
@@ -312,15 +313,15 @@ def parse_trajectory(data: Any, source: str | Path) -> Strict:
     return parse(SPECS[kind], data, source)
 
 
-def available_trajectories(directory: Path = TRAJECTORIES_DIR) -> list[str]:
-    return available_files(directory)
+def available_trajectories(directory: Path | None = None) -> list[str]:
+    return available_files(directory or search_dirs("trajectories"))
 
 
-def trajectory_path(name_or_path: str | Path, directory: Path = TRAJECTORIES_DIR) -> Path:
-    return file_path(name_or_path, directory, "trajectory")
+def trajectory_path(name_or_path: str | Path, directory: Path | None = None) -> Path:
+    return file_path(name_or_path, directory or search_dirs("trajectories"), "trajectory")
 
 
-def load_trajectory(name_or_path: str | Path, directory: Path = TRAJECTORIES_DIR) -> TrajectoryTarget | StationTarget:
+def load_trajectory(name_or_path: str | Path, directory: Path | None = None) -> TrajectoryTarget | StationTarget:
     """A trajectory by bare name (``figure_eight``) or by path to a YAML file."""
     path = trajectory_path(name_or_path, directory)
     return build_trajectory(parse_trajectory(load_yaml(path), path), str(path))

@@ -25,7 +25,7 @@ from layered_swim.fluid.plate import _plate_wrenches
 from layered_swim.geometry import quat_to_rows
 from layered_swim.state import BodyState
 
-# Yang eq. 5 ratios (see README, "Calibration"). Along the body the boxes sit in each other's
+# Yang eq. 5 ratios (docs/fluid.md). Along the body the boxes sit in each other's
 # wake, which the per-face model cannot see, so the nearby water moves with the swimmer at r_min
 # of its speed: calibrated so a towed streamlined body matches Narita et al. 2017's passive drag
 # 23.5 v^2 N. Broadside every face meets undisturbed water and the plate model alone gives a

@@ -36,8 +36,8 @@ class FrameWriter:
     """``add`` frames, then ``close`` (or ``abort``). ``path`` ending in .mp4 asks for a video;
     without an encoder (or for any other path) the frames go as PNGs into a folder, and ``note``
     says which happened. Frames go to a temporary name first and move into place on ``close``: a
-    failed render leaves nothing behind. A frame folder must be empty or hold only frames unless
-    ``overwrite``; a video file is replaced."""
+    failed render leaves nothing behind. A frame folder must be empty or hold only frames (which
+    the new ones replace); an existing video is replaced only with ``overwrite``."""
 
     def __init__(self, path: str | Path, fps: float, overwrite: bool = False):
         path = Path(path)
@@ -94,12 +94,17 @@ class FrameWriter:
     def _check_out(self, overwrite: bool) -> None:
         """Before any frame is drawn: the folder it goes into is writable, and the target is not
         something else's (see the class)."""
+        if self.path.is_symlink():
+            raise ConfigError(f"{self.path}: is a symbolic link; give the real path, if it is meant")
         if self.path.exists() and self.is_video == self.path.is_dir():
             raise ConfigError(f"{self.path}: is a {'folder' if self.is_video else 'file'}; choose another --out")
-        if not self.is_video and self.path.is_dir() and not overwrite and not all(
-                f.is_file() and f.name.startswith("frame_") and f.suffix == ".png" for f in self.path.iterdir()):
-            raise ConfigError(f"{self.path}: holds files that are not rendered frames; choose another --out "
-                              "or add --overwrite to replace them")
+        if self.is_video and self.path.exists() and not overwrite:
+            raise ConfigError(f"{self.path}: exists; choose another --out or add --overwrite to replace it")
+        if not self.is_video and self.path.is_dir() and not all(
+                f.is_file() and not f.is_symlink() and f.name.startswith("frame_") and f.suffix == ".png"
+                for f in self.path.iterdir()):
+            raise ConfigError(f"{self.path}: holds files that are not rendered frames; refusing to touch them, "
+                              "choose another --out")
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as err:

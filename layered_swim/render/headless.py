@@ -35,15 +35,20 @@ def render(source: str, out: str | Path, seconds: float | None = None, fps: floa
     if seconds is not None and not (math.isfinite(seconds) and 0 < seconds <= 3600):
         raise ConfigError(f"--seconds must be in (0, 3600], got {seconds}")
     frames = _frames(source, seconds, fps, stroke, layers, current_m_s, density_kg_m3, backend, fluid_settings)
+    count, total = next(frames)      # the source read and checked before anything is written
     os.environ["PYGLET_HEADLESS"] = "1"
     import pyglet
     pyglet.options["headless"] = True
     from layered_swim.render.renderer import Renderer, gl_config, read_pixels
 
     window = pyglet.window.Window(width, height, visible=False, config=gl_config())
-    writer = FrameWriter(out, fps, overwrite)
     try:
-        count, total = next(frames)
+        writer = FrameWriter(out, fps, overwrite)
+    except BaseException:
+        window.close()
+        frames.close()
+        raise
+    try:
         renderer = Renderer(count)
         camera = OrbitCamera(distance_m=5.5)
         iterator = range(total)

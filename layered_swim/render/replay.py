@@ -8,8 +8,8 @@ import numpy as np
 
 from layered_swim.render.scene import Scene
 from layered_swim.body.model import load_body
-from layered_swim.config import ConfigError, load_json
-from layered_swim.recorder import UNREADABLE_ARCHIVE, read_log
+from layered_swim.config import ConfigError, check_regular_file, load_json
+from layered_swim.recorder import MAX_LOG_BYTES, UNREADABLE_ARCHIVE, read_log
 
 TRAIL_SECONDS = 60.0
 
@@ -52,6 +52,7 @@ class LogReplay:
 
 
 def _track(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    check_regular_file(path, MAX_LOG_BYTES)
     try:
         with np.load(path, allow_pickle=False) as track:
             time_s, target_m = track["track_time_s"], track["target_m"]
@@ -67,9 +68,11 @@ def _current(config_path: Path) -> np.ndarray:
     if not config_path.exists():
         return np.zeros(3)
     config = load_json(config_path)
-    medium = config.get("medium") if isinstance(config, dict) else None
-    current = (config.get("current_m_s") if isinstance(config, dict) else None) or \
-        (medium.get("current_m_s") if isinstance(medium, dict) else None) or [0.0, 0.0, 0.0]
+    if not isinstance(config, dict):
+        raise ConfigError(f"{config_path}: not a run's configuration (expected a mapping, got {type(config).__name__})")
+    medium = config.get("medium")
+    current = config.get("current_m_s") or (medium.get("current_m_s") if isinstance(medium, dict) else None) or \
+        [0.0, 0.0, 0.0]
     try:
         current = np.asarray(current, float)
     except (TypeError, ValueError):

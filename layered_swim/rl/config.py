@@ -4,14 +4,26 @@ YAML values: ``--set ppo.learning_rate=1e-4``)."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 import yaml
+from pydantic import Field, field_validator, model_validator
 
 from layered_swim.config import ConfigError, Strict, between, load_yaml, parse
 from layered_swim.rl.observation import ENV_STATES
 
 SHIPPED_CONFIG = Path(__file__).with_name("front_crawl.yaml")
+CONTROL_HZ = 120        # the simulation's control rate (SimConfig.control_hz): an action spans whole control steps
+MAX_HIDDEN_WIDTH, MAX_HIDDEN_LAYERS = 4096, 8
+
+
+def count(low: int, high: int):
+    """An integer people edit with both bounds: a typo like 5000 workers or a 10^5-wide layer is
+    an error before anything is built, not a run that eats the machine."""
+    return Annotated[int, Field(ge=low, le=high)]
+
+
+Hidden = Annotated[tuple[count(1, MAX_HIDDEN_WIDTH), ...], Field(min_length=1, max_length=MAX_HIDDEN_LAYERS)]
 
 
 class EnvSpec(Strict):
@@ -19,9 +31,16 @@ class EnvSpec(Strict):
     pool: Literal["small", "large"] = "small"
     reference: Literal["basic", "layered"] = "basic"
     env_state: Literal[ENV_STATES] = "SmoothFT"
-    policy_hz: int = 30
+    policy_hz: count(1, CONTROL_HZ) = 30
     action_scale_rad: between(0.0, 1.0, above=True) = 0.2
     start_jitter: bool = True
+
+    @field_validator("policy_hz")
+    @classmethod
+    def _whole_control_steps(cls, value: int) -> int:
+        if CONTROL_HZ % value:
+            raise ValueError(f"must divide the control rate {CONTROL_HZ} Hz")
+        return value
 
 
 class RewardSpec(Strict):
@@ -38,32 +57,38 @@ class PpoSpec(Strict):
     lam: between(0.0, 1.0) = 0.95
     clip: between(0.0, 1.0, above=True) = 0.2
     learning_rate: between(0.0, 1.0, above=True) = 3e-4
-    epochs: int = 5
-    minibatch: int = 512
+    epochs: count(1, 1000) = 5
+    minibatch: count(1, 1_000_000) = 512
     value_coef: between(0.0, 100.0) = 0.5
     entropy_coef: between(0.0, 1.0) = 0.0
     max_grad_norm: between(0.0, 100.0, above=True) = 0.5
-    hidden: tuple[int, ...] = (256, 256)
+    hidden: Hidden = (256, 256)
     init_log_std: between(-10.0, 2.0) = -1.0
 
 
 class BufferSpec(Strict):
     policy: Literal["fifo", "progevict"] = "progevict"
-    capacity_episodes: int = 64
+    capacity_episodes: count(1, 100_000) = 64
     e_mid: between(-1e6, 1e6) = 30.0
     k: between(0.0, 1e6, above=True) = 5.0
     w_age: between(0.0, 1.0) = 0.5
     w_reward: between(0.0, 1.0) = 0.5
     sigma: between(0.0, 10.0, above=True) = 0.5
 
+    @model_validator(mode="after")
+    def _some_weight(self) -> "BufferSpec":
+        if self.w_age + self.w_reward <= 0:
+            raise ValueError("w_age and w_reward must not both be 0 (eq. 18 would weigh nothing)")
+        return self
+
 
 class RunSpec(Strict):
-    samples: int = 1_000_000         # environment steps in all
-    episodes_per_epoch: int = 32
-    eval_every: int = 5              # epochs between evaluations on the goal task
-    checkpoint_every: int = 1        # epochs between checkpoints
-    seed: int = 0
-    workers: int = 2
+    samples: count(1, 10**10) = 1_000_000       # environment steps in all
+    episodes_per_epoch: count(1, 10_000) = 32
+    eval_every: count(1, 1_000_000) = 5          # epochs between evaluations on the goal task
+    checkpoint_every: count(1, 1_000_000) = 1    # epochs between checkpoints
+    seed: count(0, 2**31 - 1) = 0
+    workers: count(1, 64) = 2
 
 
 class TrainSpec(Strict):
@@ -72,18 +97,6 @@ class TrainSpec(Strict):
     ppo: PpoSpec = PpoSpec()
     buffer: BufferSpec = BufferSpec()
     run: RunSpec = RunSpec()
-
-    def model_post_init(self, _context) -> None:
-        for name, value, low in (("env.policy_hz", self.env.policy_hz, 1), ("ppo.epochs", self.ppo.epochs, 1),
-                                 ("ppo.minibatch", self.ppo.minibatch, 1),
-                                 ("buffer.capacity_episodes", self.buffer.capacity_episodes, 1),
-                                 ("run.samples", self.run.samples, 1), ("run.episodes_per_epoch", self.run.episodes_per_epoch, 1),
-                                 ("run.eval_every", self.run.eval_every, 1), ("run.checkpoint_every", self.run.checkpoint_every, 1),
-                                 ("run.seed", self.run.seed, 0), ("run.workers", self.run.workers, 1)):
-            if value < low:
-                raise ValueError(f"{name} must be at least {low}, got {value}")
-        if not self.ppo.hidden or min(self.ppo.hidden) < 1:
-            raise ValueError(f"ppo.hidden must list positive layer widths, got {list(self.ppo.hidden)}")
 
 
 def load_train_spec(path: str | Path | None, overrides: list[str] = ()) -> TrainSpec:
@@ -105,9 +118,4 @@ def load_train_spec(path: str | Path | None, overrides: list[str] = ()) -> Train
             node[parts[-1]] = yaml.safe_load(text)
         except yaml.YAMLError:
             raise ConfigError(f"--set {key}: cannot read the value {text!r}") from None
-    try:
-        return parse(TrainSpec, data, f"{source}{' with --set' if overrides else ''}")
-    except ValueError as err:      # model_post_init's checks
-        if isinstance(err, ConfigError):
-            raise
-        raise ConfigError(f"{source}: {str(err).splitlines()[-1] if str(err) else err}") from None
+    return parse(TrainSpec, data, f"{source}{' with --set' if overrides else ''}")

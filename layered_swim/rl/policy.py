@@ -9,18 +9,25 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from layered_swim.config import ConfigError
+from layered_swim.config import ConfigError, parse
+from layered_swim.rl.checks import check_keys, check_normaliser, check_tensors, is_count, is_number, read_weights
+from layered_swim.rl.config import MAX_HIDDEN_LAYERS, MAX_HIDDEN_WIDTH, EnvSpec, RewardSpec
 from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, Normaliser
 from layered_swim.rl.reward import RewardWeights
 from layered_swim.tasks.goal import GOAL_METRICS
 from layered_swim.tasks.swim_benchmark import goal_leads_s
 
 POLICY_FORMAT = 1
+POLICY_KEYS = ("format", "model_args", "model", "normaliser", "env", "reward")
+MAX_POLICY_BYTES = 256 * 2**20      # the shipped policy is 1 MB; hidden [4096, 4096] about 140 MB
+MAX_IO_SIZE = 10_000                # observations or actions (the body gives 255 and 33)
 
 
 class Policy:
-    def __init__(self, model: ActorCritic, normaliser: Normaliser, env: dict, reward: dict, model_args: tuple):
+    def __init__(self, model: ActorCritic, normaliser: Normaliser, env: dict, reward: dict, model_args: tuple,
+                 source: str = "the policy"):
         self.model, self.normaliser, self.env, self.reward, self.model_args = model, normaliser, env, reward, model_args
+        self.source = source          # what error messages call it: the file it came from
 
     def to_file(self) -> dict:
         return {"format": POLICY_FORMAT, "model_args": list(self.model_args), "model": self.model.state_dict(),
@@ -28,21 +35,41 @@ class Policy:
 
     @classmethod
     def load(cls, path: str | Path) -> "Policy":
-        try:
-            data = torch.load(path, map_location="cpu", weights_only=True)
-        except FileNotFoundError:
-            raise ConfigError(f"{path}: no such policy file") from None
-        except Exception as err:      # noqa: BLE001  a damaged or foreign file: one line
-            raise ConfigError(f"{path}: not a layered-swim policy file ({type(err).__name__})") from None
-        if not isinstance(data, dict) or data.get("format") != POLICY_FORMAT:
+        """A policy file, every part checked before use: a damaged or foreign one is one
+        ConfigError naming it, never a traceback or a network of someone else's size."""
+        if not Path(path).exists():
+            raise ConfigError(f"{path}: no such policy file")
+        data = read_weights(path, MAX_POLICY_BYTES, "not a layered-swim policy file ({kind})")
+        if not (isinstance(data, dict) and type(data.get("format")) is int and data["format"] == POLICY_FORMAT):
             raise ConfigError(f"{path}: not a layered-swim policy file (format {POLICY_FORMAT})")
-        n_obs, n_act, hidden, log_std = data["model_args"]
-        model_args = (int(n_obs), int(n_act), tuple(int(h) for h in hidden), float(log_std))
+        check_keys(data, POLICY_KEYS, "policy file", path)
+        model_args = model_arguments(data["model_args"], path)
+        env, reward = section(EnvSpec, data["env"], "env", path), section(RewardSpec, data["reward"], "reward", path)
+        like = network_like(model_args)
+        size = sum(t.numel() * t.element_size() for t in like.values())
+        if size > MAX_POLICY_BYTES:      # before allocating it: the file's shapes must match these
+            raise ConfigError(f"{path}: model_args describe a {size}-byte network, more than a policy file may hold")
+        weights = check_tensors(data["model"], like, "model", path)
+        scaling = check_normaliser(data["normaliser"], model_args[0], path)
         model = ActorCritic(*model_args)
-        model.load_state_dict(data["model"])
+        model.load_state_dict(weights)
         normaliser = Normaliser(model_args[0])
-        normaliser.load_state_dict(data["normaliser"])
-        return cls(model, normaliser, dict(data["env"]), dict(data["reward"]), model_args)
+        normaliser.load_state_dict(scaling)
+        return cls(model, normaliser, env, reward, model_args, str(path))
+
+    def check_stroke(self, stroke: str | None) -> None:
+        """Refuse, in one line, to swim ``stroke`` (None: whichever it was trained for) with a
+        policy trained for another."""
+        trained = self.env["stroke"]
+        if stroke is not None and stroke != trained:
+            raise ConfigError(f"{self.source} was trained for {trained}, not {stroke}; add --stroke {trained}")
+
+    def check_sizes(self, n_obs: int, n_act: int, where: str) -> None:
+        """Refuse an episode whose observation or action differs from the network's (another body
+        or observation variant): it would fail deep in a matrix product."""
+        if (n_obs, n_act) != tuple(self.model_args[:2]):
+            raise ConfigError(f"{self.source} expects {self.model_args[0]} observations and {self.model_args[1]} "
+                              f"actions, {where} has {n_obs} and {n_act}")
 
     def env_kwargs(self, **changes) -> dict:
         """The training environment's arguments, with ``changes`` (backend, pool, current...)."""
@@ -57,11 +84,40 @@ def follow_steering(policy_path: str | Path, stroke: str):
     from layered_swim.rl.env import REFERENCES
 
     policy = Policy.load(policy_path)
-    if stroke != policy.env["stroke"]:
-        raise ConfigError(f"{policy_path} was trained for {policy.env['stroke']}; add --stroke {policy.env['stroke']}")
+    policy.check_stroke(stroke)
     return Layers.parse(REFERENCES[policy.env["reference"]]), {
         "wrap": ResidualController, "driver": lambda episode: ResidualDriver(policy, episode),
         "extra": {"policy": str(policy_path), "reference": policy.env["reference"]}}
+
+
+def model_arguments(value, source) -> tuple:
+    """``ActorCritic``'s arguments (observations, actions, hidden widths, initial log std)
+    within the training configuration's bounds."""
+    if not (isinstance(value, (list, tuple)) and len(value) == 4):
+        raise ConfigError(f"{source}: model_args must be [observations, actions, hidden widths, log std]")
+    n_obs, n_act, hidden, log_std = value
+    if not (is_count(n_obs, 1, MAX_IO_SIZE) and is_count(n_act, 1, MAX_IO_SIZE)):
+        raise ConfigError(f"{source}: model_args observations and actions must be integers in 1..{MAX_IO_SIZE}")
+    if not (isinstance(hidden, (list, tuple)) and 1 <= len(hidden) <= MAX_HIDDEN_LAYERS
+            and all(is_count(h, 1, MAX_HIDDEN_WIDTH) for h in hidden)):
+        raise ConfigError(f"{source}: model_args hidden widths must be 1 to {MAX_HIDDEN_LAYERS} integers "
+                          f"in 1..{MAX_HIDDEN_WIDTH}")
+    if not is_number(log_std):
+        raise ConfigError(f"{source}: model_args log std must be a finite number")
+    return (n_obs, n_act, tuple(hidden), float(log_std))
+
+
+def section(spec, data, name: str, source) -> dict:
+    """A file's ``env`` or ``reward`` section, complete (a default filled in would change what
+    the policy was trained for) and checked by the training configuration's ``spec``."""
+    check_keys(data, spec.model_fields, name, source)
+    return parse(spec, data, f"{source}: {name}").model_dump()
+
+
+def network_like(model_args: tuple) -> dict[str, torch.Tensor]:
+    """The state of ``ActorCritic(*model_args)``: names, shapes and dtypes, nothing allocated."""
+    with torch.device("meta"):
+        return ActorCritic(*model_args).state_dict()
 
 
 def env_arguments(env: dict, reward: dict, **changes) -> dict:
@@ -78,6 +134,7 @@ def evaluate_goals(policy: Policy, seeds: int = 5, goals: list[int] | None = Non
     env = make_env(policy.env_kwargs(**{"start_jitter": False, **env_changes}))
     runs = []
     try:
+        policy.check_sizes(env.observation_space.shape[0], env.action_space.shape[0], "the goal task")
         goals = range(len(env.episode.task.goals)) if goals is None else goals
         options = [{"goal": g, "start_seed": s} for g in goals for s in range(seeds)]
         episodes = play(env, ActorSnapshot(policy.model), policy.normaliser, list(range(len(options))), True, options)
@@ -104,10 +161,8 @@ class ResidualDriver:
         self.policy, self.episode = policy, episode
         self.actor = ActorSnapshot(policy.model)
         self.input = PolicyInput(episode, policy.env["env_state"])
-        if self.input.layout.size != policy.model_args[0]:
-            raise ConfigError(f"the policy expects {policy.model_args[0]} observations, this episode gives "
-                              f"{self.input.layout.size}")
         sim = episode.sim
+        policy.check_sizes(self.input.layout.size, len(sim.layout.names), "this episode")
         self.every = sim.config.physics_hz // int(policy.env["policy_hz"])
         self.scale = float(policy.env["action_scale_rad"])
         self.leads_s = goal_leads_s(episode.stroke.period_s)

@@ -12,16 +12,18 @@ from __future__ import annotations
 import csv
 import io
 import time
-from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
 import torch
 
-from layered_swim.config import ConfigError
-from layered_swim.outputs import COMMAND_KEY, atomic_path, write_json, write_text
-from layered_swim.rl.buffer import EpisodeBuffer, EpisodeData, EvictionSettings
+from layered_swim.config import ConfigError, parse
+from layered_swim.outputs import COMMAND_KEY, OutputFolder, atomic_path, claim, folder_path, write_json, write_text
+from layered_swim.rl.buffer import EpisodeBuffer, EvictionSettings
 from layered_swim.rl.config import TrainSpec
+from layered_swim.rl.checkpoint import (CHECKPOINT_FORMAT, MAX_COUNT, adam_state, buffer_episodes, episode_state,
+                                        numpy_rng, read_checkpoint, torch_generator)
+from layered_swim.rl.checks import check_normaliser, check_tensors, is_count, is_number
 from layered_swim.rl.policy import Policy, env_arguments, evaluate_goals
 from layered_swim.rl.ppo import ActorCritic, Normaliser, PpoSettings, update
 from layered_swim.rl.rollouts import Rollouts, make_env
@@ -64,34 +66,43 @@ class Trainer:
                       self.model_args)
 
     def save(self) -> None:
-        state = {"format": 1, "spec": self.spec.model_dump(mode="json"), "model": self.model.state_dict(),
+        state = {"format": CHECKPOINT_FORMAT, "spec": self.spec.model_dump(mode="json"), "model": self.model.state_dict(),
                  "optimiser": self.optimiser.state_dict(), "normaliser": self.normaliser.state_dict(),
                  "epoch": self.epoch, "samples": self.samples, "wall_s": self.wall_s,
                  "rng": self.rng.bit_generator.state, "generator": self.generator.get_state(),
-                 "buffer": [_episode_state(e) for e in self.buffer.episodes]}
+                 "buffer": [episode_state(e) for e in self.buffer.episodes]}
         for name, data in ((CHECKPOINT, state), (POLICY, self.policy().to_file())):
             with atomic_path(self.out / name) as tmp:
                 torch.save(data, tmp)
 
     def resume(self) -> None:
+        """Continue from ``checkpoint.pt``, every part checked before any is used (it may be a
+        file someone handed over): a bad one is one ConfigError line naming it."""
         path = self.out / CHECKPOINT
-        if not path.is_file():
+        if not path.exists():
             raise ConfigError(f"{path}: nothing to resume (no checkpoint)")
-        try:
-            state = torch.load(path, map_location="cpu", weights_only=False)   # our own file: it holds RNG states
-        except Exception as err:      # noqa: BLE001
-            raise ConfigError(f"{path}: unreadable checkpoint ({type(err).__name__})") from None
-        if _what_trains(state.get("spec")) != _what_trains(self.spec.model_dump(mode="json")):
+        state = read_checkpoint(path)
+        spec = parse(TrainSpec, state["spec"], f"{path}: spec")
+        if _what_trains(spec.model_dump(mode="json")) != _what_trains(self.spec.model_dump(mode="json")):
             raise ConfigError(f"{path}: the checkpoint was trained with another configuration than the one given "
                               f"(see {self.out / 'config.json'})")
-        self.model.load_state_dict(state["model"])
-        self.optimiser.load_state_dict(state["optimiser"])
-        self.normaliser.load_state_dict(state["normaliser"])
-        self.epoch, self.samples, self.wall_s = state["epoch"], state["samples"], state["wall_s"]
-        self.rng.bit_generator.state = state["rng"]
-        self.generator.set_state(state["generator"])
-        self.buffer.episodes = [EpisodeData(**e) for e in state["buffer"]]
-        _truncate_log(self.out / LOG, self.epoch)
+        n_obs, n_act = self.model_args[:2]
+        weights = check_tensors(state["model"], self.model.state_dict(), "model", path)
+        moments = adam_state(state["optimiser"], list(self.model.parameters()), path)
+        scaling = check_normaliser(state["normaliser"], n_obs, path)
+        epoch, samples, wall_s = state["epoch"], state["samples"], state["wall_s"]
+        if not (is_count(epoch, 0, MAX_COUNT) and is_count(samples, 0, MAX_COUNT)
+                and is_number(wall_s) and wall_s >= 0):
+            raise ConfigError(f"{path}: epoch and samples must be whole numbers, wall_s a number, none below 0")
+        rng, generator = numpy_rng(state["rng"], path), torch_generator(state["generator"], path)
+        episodes = buffer_episodes(state["buffer"], n_obs, n_act, self.buffer.capacity, epoch, path)
+        self.model.load_state_dict(weights)
+        # The settings are the configuration's (the checkpoint's is the same: checked above).
+        self.optimiser.load_state_dict({"state": moments, "param_groups": self.optimiser.state_dict()["param_groups"]})
+        self.normaliser.load_state_dict(scaling)
+        self.epoch, self.samples, self.wall_s = epoch, samples, float(wall_s)
+        self.rng, self.generator = rng, generator
+        self.buffer.episodes = episodes
 
     # -- the loop -------------------------------------------------------------------------
     def run(self, progress: bool = False, say=print) -> dict:
@@ -144,30 +155,27 @@ class Trainer:
                 "checkpoint": str(self.out / CHECKPOINT), "policy": str(self.out / POLICY)}
 
 
-def train(spec: TrainSpec, out_dir: Path, resume: bool = False, progress: bool = False,
+def train(spec: TrainSpec, out_dir: OutputFolder | Path, resume: bool = False, progress: bool = False,
           ray_address: str | None = None, say=print) -> dict:
-    Path(out_dir).mkdir(parents=True, exist_ok=True)
-    trainer = Trainer(spec, out_dir, ray_address)
+    """Train into ``out_dir``: claimed (an ``OutputFolder``) only once the environment is built
+    and, with ``resume``, the checkpoint read and checked."""
+    trainer = Trainer(spec, folder_path(out_dir), ray_address)
     if resume:
         trainer.resume()
-    write_json(Path(out_dir) / "config.json", {COMMAND_KEY: "train", **spec.model_dump(mode="json"),
+    claim(out_dir)
+    if resume:
+        _truncate_log(trainer.out / LOG, trainer.epoch)
+    write_json(trainer.out / "config.json", {COMMAND_KEY: "train", **spec.model_dump(mode="json"),
                                                "observation_layout": trainer.layout,
                                                "ray_address": ray_address})
     return trainer.run(progress, say)
 
 
-def _what_trains(spec: dict | None) -> dict | None:
+def _what_trains(spec: dict) -> dict:
     """The configuration less what a resumed run may change: how long, on how many workers,
     how often it evaluates and saves."""
-    if spec is None:
-        return None
     run = {k: v for k, v in spec.get("run", {}).items() if k not in ("samples", "workers", "eval_every", "checkpoint_every")}
     return {**spec, "run": run}
-
-
-def _episode_state(e: EpisodeData) -> dict:
-    return {"obs": e.obs, "actions": e.actions, "log_probs": e.log_probs, "rewards": e.rewards,
-            "final_obs": e.final_obs, "truncated": e.truncated, "epoch": e.epoch}
 
 
 def _append_log(path: Path, row: dict) -> None:

@@ -18,7 +18,7 @@ from pathlib import Path
 from layered_swim.analysis import report
 from layered_swim.analysis.sweep import run_sweep
 from layered_swim.config import ConfigError
-from layered_swim.outputs import COMMAND_KEY, write_json, write_text
+from layered_swim.outputs import COMMAND_KEY, OutputFolder, claim, write_json, write_text
 from layered_swim.runs import versions
 
 
@@ -30,19 +30,18 @@ class Outcome:
     numbers: dict = field(default_factory=dict)
 
 
-def run_experiment(module, out_dir: str | Path, quick: bool = False, workers: int = 2, progress: bool = False,
+def run_experiment(module, out_dir: OutputFolder | str | Path, quick: bool = False, workers: int = 2, progress: bool = False,
                    seed: int = 0, backend: str = "plate", fluid_settings=None) -> dict:
     if not isinstance(seed, int) or seed < 0:
         raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
     backends = getattr(module, "BACKENDS", ("plate",))
     if backend not in backends:
         raise ConfigError(f"experiment {module.NAME} runs on the {' and '.join(backends)} backend only, not {backend}")
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     configs = module.configs(quick, seed)
     if backend != "plate":      # plate configs stay as they were: their cached results still count
         fluid = asdict(fluid_settings) if fluid_settings is not None else None
         configs = [{**config, "backend": backend, "fluid": fluid} for config in configs]
+    out = claim(out_dir)
     # config.json first: a sweep stopped halfway leaves a folder the next run recognises (and
     # whose cache it reuses), not one it refuses as foreign.
     write_json(out / "config.json", {COMMAND_KEY: "experiment", "experiment": module.NAME, "quick": quick, "seed": seed, "runs": configs,

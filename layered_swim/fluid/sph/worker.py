@@ -152,8 +152,9 @@ class SphWorker:
         except (EOFError, OSError):
             code = self._process.wait(10)
             self._process = None
+            # Its log's last line, not its path: close() deletes the log before anyone reads the message.
             raise FluidError(f"the SPH solver process died during {command!r} (exit code {code}): "
-                             f"{self._last_log_line()} (log: {self.log_path})") from None
+                             f"{self._last_log_line()}") from None
         if status == "error":
             raise FluidError(f"SPH solver failed during {command!r}: {reply}")
         return reply

@@ -1,0 +1,51 @@
+"""``layered-swim train``: train a residual policy with PPO on SWIM's goal task ([rl] extra)."""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from layered_swim.commands.options import MAX_WORKERS, count, out_dir, overwrite_option, progress
+
+
+def add_parser(subparsers) -> None:
+    train = subparsers.add_parser("train", help="train a residual policy with PPO on SWIM's goal task ([rl] extra)")
+    train.add_argument("--config", metavar="FILE", help="training YAML (default: the shipped front-crawl one)")
+    train.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help="override a field, e.g. --set ppo.learning_rate=1e-4 (repeatable)")
+    train.add_argument("--samples", type=count(1, 10**10), help="environment steps in all (run.samples)")
+    train.add_argument("--workers", type=count(1, MAX_WORKERS), help="rollout worker processes (run.workers; default 2)")
+    train.add_argument("--buffer", choices=("fifo", "progevict"), help="episode buffer eviction (buffer.policy)")
+    train.add_argument("--ray", metavar="ADDRESS", help="run the rollout workers on a Ray cluster ('local': start one here)")
+    train.add_argument("--out", help="output folder (default runs/train-<stroke>)")
+    train.add_argument("--resume", action="store_true", help="continue the training in --out from its checkpoint")
+    overwrite_option(train)
+    train.add_argument("--no-progress", action="store_true", help="no progress bar")
+    train.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+
+
+def run(args) -> None:
+    from layered_swim.config import ConfigError
+    from layered_swim.rl.config import load_train_spec
+    from layered_swim.rl.train import CHECKPOINT, train
+
+    overrides = list(args.set)
+    for key, value in (("run.samples", args.samples), ("run.workers", args.workers), ("buffer.policy", args.buffer)):
+        if value is not None:
+            overrides.append(f"{key}={value}")
+    spec = load_train_spec(args.config, overrides)
+    default = Path("runs") / f"train-{spec.env.stroke}"
+    if args.resume and args.overwrite:
+        raise ConfigError("--resume continues the training in --out and --overwrite starts it over: choose one")
+    out = out_dir(args, default)
+    if args.resume and not (out.path / CHECKPOINT).is_file():
+        raise ConfigError(f"{out.path}: nothing to resume (no {CHECKPOINT})")
+    if not args.resume and (out.path / CHECKPOINT).is_file() and not args.overwrite:
+        raise ConfigError(f"{out.path}: holds a training run; add --resume to continue it or --overwrite to start over")
+    say = None if args.json or progress(args) else (lambda text: print(text, file=sys.stderr))
+    result = train(spec, out, resume=args.resume, progress=progress(args), ray_address=args.ray, say=say)
+    if args.json:
+        print(json.dumps(result, allow_nan=False))
+        return
+    print(f"trained {result['samples']} samples in {result['epochs']} epochs ({result['wall_s']:.0f} s); "
+          f"policy: {result['policy']}")

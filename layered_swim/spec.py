@@ -1,0 +1,130 @@
+"""One description of a swim: ``SwimSpec``, frozen and validated, from which every command builds
+its ``Episode`` (``SwimSpec.episode``). Its dump is the ``swim`` field of every run folder's
+``config.json``, so ``layered-swim run --config FOLDER/config.json`` swims the same swim again,
+bit for bit.
+
+What it holds: the stroke, the task (free swimming, a trajectory to follow, SWIM's goal
+reaching), the water (preset, density, current), the fluid backend and its settings, the rates,
+the layers, the seed and how far a seed moves the start, and a learned residual's file.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict
+from typing import Annotated, Literal, Union
+
+from pydantic import Field
+
+from layered_swim.config import ConfigError, Strict, between
+from layered_swim.control.layered import Layers
+from layered_swim.control.policy import TempoControl
+from layered_swim.episode import START_JITTER, WIDE_JITTER, Episode
+from layered_swim.fluid.medium import Medium, preset
+from layered_swim.recorder import DEFAULT_LOG_HZ
+from layered_swim.sim.simulation import SimConfig
+
+PHYSICS_HZ = SimConfig().physics_hz
+MAX_SECONDS = 3600.0
+MIN_SECONDS = 0.1        # a few log samples, so the metrics have a time span
+JITTERS = {"start": START_JITTER, "wide": WIDE_JITTER}
+# Slow strokes: the goal line is slow. Its schedule is not a pace to keep: keeping the calibrated
+# pace of the goal's speed (steady, straight) brought the crawl there far too early (Prog 1.16).
+GOAL_TEMPO = TempoControl(min_tempo=0.25, near_m=0.3, far_m=1.0, keep_pace=False)
+
+Speed_m_s = between(-5.0, 5.0)
+
+
+class MediumSpec(Strict):
+    """The water: a preset (its density and viscosity), optionally another density, a current."""
+
+    fluid: Literal["fresh_water", "seawater"] = "fresh_water"
+    density_kg_m3: between(1.0, 20000.0) | None = None
+    current_m_s: tuple[Speed_m_s, Speed_m_s, Speed_m_s] = (0.0, 0.0, 0.0)
+
+    def medium(self) -> Medium:
+        water = preset(self.fluid).with_(current_m_s=tuple(float(c) for c in self.current_m_s))
+        return water if self.density_kg_m3 is None else water.with_(rho_kg_m3=float(self.density_kg_m3))
+
+
+class FreeSwimTask(Strict):
+    kind: Literal["free"] = "free"
+
+
+class FollowTask(Strict):
+    kind: Literal["follow"] = "follow"
+    trajectory: str = Field(min_length=1)       # a name (trajectories/) or a path to a .yaml
+
+
+class GoalTask(Strict):
+    kind: Literal["goal"] = "goal"
+    pool: Literal["small", "large"] = "small"
+
+
+TaskSpec = Annotated[Union[FreeSwimTask, FollowTask, GoalTask], Field(discriminator="kind")]
+
+
+class SwimSpec(Strict):
+    stroke: str = Field(min_length=1)           # a name (strokes/), a path to a .yaml, or auto
+    task: TaskSpec = FreeSwimTask()
+    seconds: between(MIN_SECONDS, MAX_SECONDS) = 30.0   # goal: each goal's horizon is the pool's
+    medium: MediumSpec = MediumSpec()
+    backend: str = "plate"
+    sph: dict | None = None                     # the SPH settings' fields (backend sph)
+    physics_hz: int = Field(PHYSICS_HZ, ge=120, le=5000)
+    log_hz: int = Field(DEFAULT_LOG_HZ, ge=1, le=5000)
+    tempo: between(0.1, 5.0) = 1.0
+    lung_air_l: between(0.0, 8.0) | None = None
+    layers: str = Layers().describe()
+    seed: int = Field(0, ge=0, le=2**31 - 1)    # 0: the task's exact start; others jitter it
+    jitter: Literal["start", "wide"] = "start"  # how far a seed moves the start
+    policy: str | None = None                   # a learned residual (policy.pt) on its reference
+
+    def model_post_init(self, _context) -> None:
+        Layers.parse(self.layers)                # one line if malformed
+        if self.sph is not None and self.backend != "sph":
+            raise ConfigError(f"sph settings are for backend sph, not {self.backend}")
+
+    @property
+    def layer_set(self) -> Layers:
+        return Layers.parse(self.layers)
+
+    def fluid_settings(self):
+        """The backend's settings object: SPH's from ``sph``; None (its defaults) otherwise."""
+        if self.sph is None:
+            return None
+        from layered_swim.fluid.sph import SphSettings
+
+        fields = {**self.sph, "pool_size_m": tuple(self.sph.get("pool_size_m", SphSettings().pool_size_m))}
+        try:
+            return SphSettings(**fields)
+        except TypeError as err:
+            raise ConfigError(f"sph settings: {err}") from None
+
+    def episode(self, wrap=None, layers: Layers | None = None) -> Episode:
+        """The episode this spec describes (``wrap``/``layers``: a learned residual's controller
+        around its reference layers, see ``rl.policy.Policy.attach``)."""
+        from layered_swim.tasks import FollowTarget, FreeSwim, GoalReaching
+
+        task = self.task
+        if isinstance(task, FollowTask):
+            from layered_swim.control.targets import load_trajectory
+
+            built = FollowTarget(load_trajectory(task.trajectory))
+        elif isinstance(task, GoalTask):
+            from layered_swim.tasks import swim_benchmark
+
+            built = GoalReaching(swim_benchmark.pool(task.pool))
+        else:
+            built = FreeSwim(sample_hz=self.log_hz)
+        return Episode(self.stroke, built, medium=self.medium.medium(), backend=self.backend,
+                       fluid_settings=self.fluid_settings(), lung_air_l=self.lung_air_l, physics_hz=self.physics_hz,
+                       tempo=self.tempo, layers=layers or self.layer_set,
+                       tempo_control=GOAL_TEMPO if isinstance(task, GoalTask) else None, seed=self.seed,
+                       jitter=JITTERS[self.jitter], wrap=wrap)
+
+    def with_(self, **changes) -> "SwimSpec":
+        return type(self).model_validate({**self.model_dump(), **changes})
+
+
+def sph_fields(settings) -> dict | None:
+    """An SPH settings object as ``SwimSpec.sph`` holds it."""
+    return None if settings is None else asdict(settings)
