@@ -46,7 +46,7 @@ from layered_swim.control.stroke import LEVEL_OFF, Stroke, StrokeSpec, build_str
 from layered_swim.control.targets import Target
 from layered_swim.fluid import make_fluid
 from layered_swim.fluid.medium import Medium
-from layered_swim.sim.simulation import SimConfig, Simulation
+from layered_swim.sim.simulation import DEFAULT_SIM, PHYSICS_HZ, Simulation
 from layered_swim.state import BodyState, JointLayout, Start, lying
 from layered_swim.tasks import Task
 
@@ -70,7 +70,7 @@ WIDE_JITTER = StartJitter(heading_rad=math.radians(10.0), position_m=0.3)
 
 class Episode:
     def __init__(self, stroke: str, task: Task | None = None, *, medium: Medium = Medium(), backend: str = "plate",
-                 fluid_settings=None, lung_air_l: float | None = None, physics_hz: int = 480, tempo: float = 1.0,
+                 fluid_settings=None, lung_air_l: float | None = None, physics_hz: int = PHYSICS_HZ, tempo: float = 1.0,
                  layers: Layers = Layers(), weights: WeightPolicy | None = None,
                  tempo_control: TempoControl | None = None, seed: int = 0, jitter: StartJitter = START_JITTER,
                  wrap: Callable[[object, JointLayout], object] | None = None):
@@ -101,7 +101,7 @@ class Episode:
                                      tempo_control)
         if wrap is not None:          # e.g. a learned residual on top (control/residual.py)
             controller = wrap(controller, layout)
-        config = SimConfig(physics_hz=physics_hz)
+        config = DEFAULT_SIM.at(physics_hz)
         fluid = make_fluid(backend, self.body, medium, config.gravity_m_s2, fluid_settings)
         self.sim = Simulation(self.body, controller, fluid, config, layout, self.stroke.pd_gain_scale)
         try:

@@ -1,8 +1,9 @@
-"""Headless runs: an episode per command, run, measured and written to a folder.
+"""Headless runs: a ``SwimSpec``'s episode per command, run, measured and written to a folder.
 
 ``run_swim`` is ``layered-swim run`` (free swimming), ``follow_run`` is ``follow`` (a trajectory
 file), ``goal_run`` is ``goal`` (SWIM's benchmark: one episode reset onto each goal in turn);
-``bench_step`` times one physics step bare and through the episode loop.
+``repeatable`` reads the swim a run folder's ``config.json`` describes; ``bench_step`` times one
+physics step bare and through the episode loop.
 """
 from __future__ import annotations
 
@@ -22,34 +23,22 @@ from pathlib import Path
 
 import numpy as np
 
-from layered_swim.config import ConfigError
-from layered_swim.control.layered import Layers
-from layered_swim.control.policy import TempoControl
+from layered_swim.config import ConfigError, load_json, parse
 from layered_swim.control.stroke import available_strokes
-from layered_swim.control.targets import load_trajectory
-from layered_swim.episode import START_JITTER, Episode, StartJitter
-from layered_swim.fluid.medium import Medium, preset
+from layered_swim.episode import Episode
 from layered_swim.fluid.backend import FluidError
-from layered_swim.outputs import COMMAND_KEY, OutputFolder, atomic_path, claim, folder_path, write_json
+from layered_swim.outputs import COMMAND_KEY, OutputFolder, atomic_path, claim, write_json
 from layered_swim.recorder import DEFAULT_LOG_HZ, SPOOL_DIR, Recorder
 from layered_swim.sim.simulation import SimulationDiverged
-from layered_swim.tasks import FollowTarget, FreeSwim, GoalReaching, swim_benchmark as bench
+from layered_swim.spec import MIN_SECONDS, FollowTask, FreeSwimTask, GoalTask, SwimSpec
+from layered_swim.tasks import swim_benchmark as bench
 from layered_swim.tasks.goal import GOAL_METRICS
 
-MAX_SECONDS = 3600.0
-MIN_SECONDS = 0.1        # a few log samples, so the metrics have a time span
+MAX_SECONDS = 3600.0     # a swim analyze or bench measures (run, follow, soak: SwimSpec's bounds)
 BENCH_REPEATS = 5       # bare and loop timed in turn, the fastest of each kept: other load only adds time
 BENCH_WARMUP_S = 0.5     # compiles (or loads) the numba fluid kernels before timing
 SPIKE_BOUND_WEIGHTS = 3.0    # the SPH water's total force on the body (20 ms means) stays under 3 body weights
-# Slow strokes: the goal line is slow. Its schedule is not a pace to keep: keeping the calibrated
-# pace of the goal's speed (steady, straight) brought the crawl there far too early (Prog 1.16).
-GOAL_TEMPO = TempoControl(min_tempo=0.25, near_m=0.3, far_m=1.0, keep_pace=False)
-
-
-def make_medium(fluid: str = "fresh_water", density_kg_m3: float | None = None,
-                current_m_s=(0.0, 0.0, 0.0)) -> Medium:
-    medium = preset(fluid).with_(current_m_s=tuple(float(c) for c in current_m_s))
-    return medium if density_kg_m3 is None else medium.with_(rho_kg_m3=float(density_kg_m3))
+REPEATABLE = ("run", "follow", "goal")     # the commands `run --config` repeats from their folder
 
 
 def package_version() -> str:
@@ -59,11 +48,14 @@ def package_version() -> str:
         return "unknown (not installed)"
 
 
-def resolved_config(episode: Episode, arguments: dict, log_hz: int, command: str) -> dict:
+def resolved_config(episode: Episode, spec: SwimSpec, command: str, **extra) -> dict:
+    """A run folder's ``config.json``: the command, the swim (``spec``: enough to repeat it),
+    what it resolved to (files, water, rates) and ``extra`` (the command's own settings)."""
     sim = episode.sim
     return {
         COMMAND_KEY: command,
-        "arguments": arguments,
+        "swim": spec.model_dump(mode="json"),
+        **extra,
         "stroke_file": episode.stroke.source,
         "stroke": episode.stroke_spec.model_dump(mode="json"),
         "body_file": sim.body.source,
@@ -73,7 +65,7 @@ def resolved_config(episode: Episode, arguments: dict, log_hz: int, command: str
         "gravity_m_s2": sim.config.gravity_m_s2,
         "physics_hz": sim.config.physics_hz,
         "control_hz": sim.config.control_hz,
-        "log_hz": log_hz,
+        "log_hz": spec.log_hz,
         "cycles_per_s": sim.controller.cycles_per_s,
         "task": episode.task.name,
         "seed": episode.seed,
@@ -117,27 +109,17 @@ def record(episode: Episode, seconds: float, log_hz: int = DEFAULT_LOG_HZ, progr
     return recorder
 
 
-def run_swim(stroke: str, seconds: float = 30.0, lung_air_l: float | None = None,
-             density: float | None = None, out_dir: OutputFolder | str | Path | None = None, seed: int = 0,
-             physics_hz: int = 480, tempo: float = 1.0, fluid: str = "fresh_water",
-             log_hz: int = DEFAULT_LOG_HZ, progress: bool = False, backend: str = "plate",
-             fluid_settings=None) -> dict:
-    """Run ``stroke`` for ``seconds`` and write summary.json, log.npz, timeseries.csv and
-    config.json into ``out_dir`` (default: ``runs/<stroke>-<timestamp>``; an ``OutputFolder`` is
-    claimed once everything is checked); returns the summary."""
-    out = out_dir if out_dir is not None else default_out_dir(stroke)
-    arguments = {"stroke": stroke, "seconds": seconds, "lung_air_l": lung_air_l, "density": density,
-                 "out_dir": str(folder_path(out)), "seed": seed, "physics_hz": physics_hz, "tempo": tempo,
-                 "fluid": fluid, "log_hz": log_hz, "backend": backend}
-    check_seconds(seconds)
-    if seconds > WARM_UP_AFTER_S:
-        warm_compiled_kernels(stroke)
-    episode = Episode(stroke, FreeSwim(sample_hz=log_hz), medium=make_medium(fluid, density), backend=backend,
-                      fluid_settings=fluid_settings, lung_air_l=lung_air_l, physics_hz=physics_hz, tempo=tempo,
-                      seed=seed)
-    out_dir = _claim(out, episode)
-    write_json(out_dir / "config.json", resolved_config(episode, arguments, log_hz, "run"))
-    return logged_swim(episode, seconds, out_dir, log_hz, progress)
+def run_swim(spec: SwimSpec, out_dir: OutputFolder | str | Path | None = None, progress: bool = False) -> dict:
+    """Free swimming: ``spec.seconds`` of its stroke; writes summary.json, log.npz, timeseries.csv
+    and config.json into ``out_dir`` (default: ``runs/<stroke>-<timestamp>``; an ``OutputFolder``
+    is claimed once everything is checked); returns the summary."""
+    _expect(spec, FreeSwimTask, "run")
+    if spec.seconds > WARM_UP_AFTER_S:
+        warm_compiled_kernels(spec.stroke)
+    episode = spec.episode()
+    out = _claim(out_dir if out_dir is not None else default_out_dir(spec.stroke), episode)
+    write_json(out / "config.json", resolved_config(episode, spec, "run"))
+    return logged_swim(episode, spec.seconds, out, spec.log_hz, progress)
 
 
 def logged_swim(episode: Episode, seconds: float, out_dir: Path, log_hz: int = DEFAULT_LOG_HZ,
@@ -243,12 +225,11 @@ def soak(hours: float, stroke: str, out_dir: OutputFolder | Path, progress: bool
     and at peak, the growth over the stretch, and whether everything stayed finite."""
     if not (math.isfinite(hours) and 0.0 < hours <= 24.0):
         raise ConfigError(f"--hours must be in (0, 24], got {hours}")
-    seconds = hours * 3600.0
+    spec = SwimSpec(stroke=stroke, seconds=hours * 3600.0)
     warm_compiled_kernels(stroke)
-    episode = Episode(stroke, FreeSwim(sample_hz=DEFAULT_LOG_HZ))
+    episode = spec.episode()
     out_dir = _claim(out_dir, episode)
-    write_json(out_dir / "config.json", resolved_config(episode, {"hours": hours, "stroke": stroke,
-                                                                  "out_dir": str(out_dir)}, DEFAULT_LOG_HZ, "soak"))
+    write_json(out_dir / "config.json", resolved_config(episode, spec, "soak", hours=hours))
     every = int(round(SOAK_SAMPLE_S * episode.sim.config.physics_hz))
     samples = [(0.0, rss_mb())]
     sample = (lambda sim: samples.append((sim.time_s, rss_mb())) if sim.steps % every == 0 else None)
@@ -263,7 +244,7 @@ def soak(hours: float, stroke: str, out_dir: OutputFolder | Path, progress: bool
                            "growth_mb": round(growth, 1), "growth_mb_per_hour": round(growth / span_h, 1),
                            "process_peak_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)}}
 
-    result = logged_swim(episode, seconds, out_dir, progress=progress, observers=[sample], report=memory)
+    result = logged_swim(episode, spec.seconds, out_dir, progress=progress, observers=[sample], report=memory)
     numbers = [v for v in result.values() if isinstance(v, float)]
     result["finite"] = bool(np.isfinite(numbers).all())
     write_json(out_dir / "summary.json", result)
@@ -285,47 +266,39 @@ def _metrics(episode: Episode, stopped: BaseException | None) -> dict:
     return metrics
 
 
-def follow_run(trajectory: str, stroke: str = "breaststroke", layers: Layers = Layers(), current=(0.0, 0.0, 0.0),
-               density: float | None = None, seconds: float = 60.0, out_dir: OutputFolder | str | Path | None = None,
-               backend: str = "plate", fluid_settings=None, wrap=None, driver=None, extra: dict | None = None,
-               seed: int = 0, jitter: StartJitter = START_JITTER) -> dict:
-    """Follow ``trajectory``. ``wrap`` and ``driver`` put something else in charge of the
-    controller: ``wrap`` goes around it (``Episode``'s), ``driver(episode)`` makes an observer
-    that steers it every step (a learned residual's ``ResidualDriver``); ``extra`` joins the summary.
-    A non-zero ``seed`` moves the start within ``jitter``."""
-    check_seconds(seconds)
-    target = load_trajectory(trajectory)
-    episode = Episode(stroke, FollowTarget(target), medium=make_medium(density_kg_m3=density, current_m_s=current),
-                      layers=layers, backend=backend, fluid_settings=fluid_settings, wrap=wrap, seed=seed, jitter=jitter)
-    check_path_in_pool(episode, target, seconds)
-    observers = [driver(episode)] if driver is not None else []
-    head = {"trajectory": target.name, "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
-            "seconds": seconds, "seed": seed, **(extra or {})}
+def follow_run(spec: SwimSpec, out_dir: OutputFolder | str | Path | None = None, steering=None) -> dict:
+    """Follow the spec's trajectory for ``spec.seconds``. With ``spec.policy``, ``steering`` (its
+    ``learned.steering_for(spec)``) puts the learned residual in charge of its own reference
+    controller. Without ``out_dir`` only the summary comes back."""
+    _expect(spec, FollowTask, "follow")
+    if (spec.policy is None) != (steering is None):
+        raise ConfigError("a swim with a policy needs its steering, and only such a swim")
+    episode = spec.episode() if steering is None else spec.episode(steering.wrap, steering.layers)
+    target = episode.task.target
+    check_path_in_pool(episode, target, spec.seconds)
+    observers = [] if steering is None else [steering.driver(episode)]
+    head = {"trajectory": target.name, "stroke": spec.stroke,
+            "layers": (spec.layer_set if steering is None else steering.layers).describe(),
+            "current_m_s": list(spec.medium.current_m_s), "seconds": spec.seconds, "seed": spec.seed,
+            **({} if steering is None else steering.summary)}
     if out_dir is None:
-        swim(episode, seconds, observers)
+        swim(episode, spec.seconds, observers)
         return {**head, **episode.metrics(), **fluid_report(episode)}
     out = _claim(out_dir, episode)
-    write_json(out / "config.json", {COMMAND_KEY: "follow", "trajectory": str(target.source),
-                                     "trajectory_spec": _dump(target.spec), "stroke": stroke,
-                                     "layers": layers.describe(), "current_m_s": list(current),
-                                     "density_kg_m3": density, "seconds": seconds, "seed": seed,
-                                     "start_jitter": asdict(jitter), "stroke_file": episode.stroke.source,
-                                     "fluid_backend": {"name": episode.sim.fluid.name,
-                                                       "settings": episode.sim.fluid.settings()},
-                                     "cycles_per_s_at_tempo_1": 1.0 / episode.stroke.period_s})
+    write_json(out / "config.json", resolved_config(episode, spec, "follow", trajectory_file=str(target.source),
+                                                    trajectory=_dump(target.spec)))
     try:
-        return logged_swim(episode, seconds, out, extra=head, observers=observers)
+        return logged_swim(episode, spec.seconds, out, spec.log_hz, extra=head, observers=observers)
     finally:
         with atomic_path(out / "track.npz") as tmp:
             np.savez_compressed(tmp, **episode.task.track())
 
 
-def goal_episode(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layers = Layers(),
-                 backend: str = "plate", fluid_settings=None, wrap=None) -> Episode:
-    """An episode of SWIM's goal reaching in ``pool_name``; ``reset(goal=k)`` picks the goal.
-    ``wrap``: a controller around the layered one (``Episode``'s, e.g. a learned residual)."""
-    return Episode(stroke, GoalReaching(bench.pool(pool_name)), medium=make_medium(current_m_s=current),
-                   layers=layers, tempo_control=GOAL_TEMPO, backend=backend, fluid_settings=fluid_settings, wrap=wrap)
+def goal_episode(spec: SwimSpec, wrap=None) -> Episode:
+    """An episode of SWIM's goal reaching (``spec.task`` a goal task); ``reset(goal=k)`` picks the
+    goal. ``wrap``: a controller around the layered one (a learned residual)."""
+    _expect(spec, GoalTask, "goal")
+    return spec.episode(wrap)
 
 
 def reach_goal(episode: Episode, goal: int, observers=()) -> dict:
@@ -335,18 +308,54 @@ def reach_goal(episode: Episode, goal: int, observers=()) -> dict:
     return episode.metrics()
 
 
-def goal_run(pool_name: str, stroke: str, current=(0.0, 0.0, 0.0), layers: Layers = Layers(),
-             backend: str = "plate", fluid_settings=None) -> dict:
-    episode = goal_episode(pool_name, stroke, current, layers, backend, fluid_settings)
+def goal_run(spec: SwimSpec, out_dir: OutputFolder | str | Path | None = None) -> dict:
+    """Every goal of the spec's pool in turn, one episode reset onto each. With ``out_dir``, each
+    goal's swim is logged into ``goal-<k>/`` there (a run folder of its own: log.npz,
+    timeseries.csv, summary.json), beside config.json and the summary of all."""
+    episode = goal_episode(spec)
+    out = None if out_dir is None else _claim(out_dir, episode)
     per_goal = []
     try:
+        if out is not None:
+            write_json(out / "config.json", resolved_config(episode, spec, "goal"))
         for k in range(len(episode.task.goals)):
-            per_goal.append({**reach_goal(episode, k), **fluid_report(episode)})
+            if out is None:
+                per_goal.append({**reach_goal(episode, k), **fluid_report(episode)})
+                continue
+            episode.reset(goal=k)
+            folder = out / f"goal-{k}"
+            folder.mkdir(exist_ok=True)
+            recorder = Recorder(episode.sim, spec.log_hz, joint_work=True, spool_dir=folder / SPOOL_DIR)
+            episode.run(episode.task.duration_s, observers=[recorder])
+            per_goal.append({**episode.metrics(), **fluid_report(episode)})
+            recorder.save(folder)
+            write_json(folder / "summary.json", per_goal[-1])
     finally:
         episode.close()
     mean = {k: float(np.mean([g[k] for g in per_goal])) for k in GOAL_METRICS}
-    return {"pool": pool_name, "stroke": stroke, "layers": layers.describe(), "current_m_s": list(current),
-            "fluid_backend": backend, **mean, "goals": per_goal, "swim_published": bench.SWIM_PUBLISHED.get(pool_name)}
+    pool = spec.task.pool
+    result = {"pool": pool, "stroke": spec.stroke, "layers": spec.layer_set.describe(),
+              "current_m_s": list(spec.medium.current_m_s), "fluid_backend": spec.backend, **mean, "goals": per_goal,
+              "swim_published": bench.SWIM_PUBLISHED.get(pool)}
+    if out is not None:
+        write_json(out / "summary.json", result)
+    return result
+
+
+def repeatable(config_path: str | Path) -> tuple[str, SwimSpec]:
+    """The command and swim a run, follow or goal folder's ``config.json`` describes, checked:
+    swum again (``layered-swim run --config``) it logs the same bits."""
+    config = load_json(config_path)
+    command = config.get(COMMAND_KEY) if isinstance(config, dict) else None
+    if command not in REPEATABLE or not isinstance(config.get("swim"), dict):
+        raise ConfigError(f"{config_path}: not the config.json of a {', '.join(REPEATABLE)} folder of this version "
+                          "(no command and swim)")
+    return command, parse(SwimSpec, config["swim"], f"{config_path}: swim")
+
+
+def _expect(spec: SwimSpec, task: type, command: str) -> None:
+    if not isinstance(spec.task, task):
+        raise ConfigError(f"`{command}` swims a {task.model_fields['kind'].default} task, not {spec.task.kind}")
 
 
 def sph_settings_for(pool_name: str, water_depth_m: float | None = None, **options):
@@ -432,7 +441,7 @@ def bench_sph(seconds: float = 0.5, settings=None, stroke: str = "breaststroke")
             "build_s": report["build_s"]}
 
 
-def bench_step(seconds: float = 5.0, physics_hz: int = 480, stroke: str | None = None) -> dict:
+def bench_step(seconds: float = 5.0, physics_hz: int | None = None, stroke: str | None = None) -> dict:
     """Microseconds per physics step: (a) the bare PyBullet step of the floating body (no fluid,
     no PD), (b) the whole loop (state read, fluid, wrenches, PD, step) through the episode runner. Each is timed BENCH_REPEATS times, alternating so that a burst of
     load elsewhere hits both, and the fastest repeat counts (the usual rule for timing: noise
@@ -440,7 +449,7 @@ def bench_step(seconds: float = 5.0, physics_hz: int = 480, stroke: str | None =
     check_seconds(seconds)
     if stroke is None:
         stroke = "front_crawl" if "front_crawl" in available_strokes() else "rest"
-    episode = Episode(stroke, physics_hz=physics_hz)
+    episode = Episode(stroke) if physics_hz is None else Episode(stroke, physics_hz=physics_hz)
     steps = int(round(seconds * physics_hz))
     world = episode.sim.world
 

@@ -14,17 +14,16 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field
 
-from layered_swim.config import ConfigError, Strict, between
+from layered_swim.config import ConfigError, Strict, between, parse
 from layered_swim.control.layered import Layers
 from layered_swim.control.policy import TempoControl
 from layered_swim.episode import START_JITTER, WIDE_JITTER, Episode
-from layered_swim.fluid.medium import Medium, preset
+from layered_swim.fluid.medium import Medium, water
 from layered_swim.recorder import DEFAULT_LOG_HZ
-from layered_swim.sim.simulation import SimConfig
+from layered_swim.sim.simulation import PHYSICS_HZ
 
-PHYSICS_HZ = SimConfig().physics_hz
-MAX_SECONDS = 3600.0
-MIN_SECONDS = 0.1        # a few log samples, so the metrics have a time span
+MAX_SECONDS = 24 * 3600.0     # a day: soak's longest; the log streams to disk, memory stays flat
+MIN_SECONDS = 0.1             # a few log samples, so the metrics have a time span
 JITTERS = {"start": START_JITTER, "wide": WIDE_JITTER}
 # Slow strokes: the goal line is slow. Its schedule is not a pace to keep: keeping the calibrated
 # pace of the goal's speed (steady, straight) brought the crawl there far too early (Prog 1.16).
@@ -41,8 +40,7 @@ class MediumSpec(Strict):
     current_m_s: tuple[Speed_m_s, Speed_m_s, Speed_m_s] = (0.0, 0.0, 0.0)
 
     def medium(self) -> Medium:
-        water = preset(self.fluid).with_(current_m_s=tuple(float(c) for c in self.current_m_s))
-        return water if self.density_kg_m3 is None else water.with_(rho_kg_m3=float(self.density_kg_m3))
+        return water(self.fluid, self.density_kg_m3, self.current_m_s)
 
 
 class FreeSwimTask(Strict):
@@ -121,8 +119,14 @@ class SwimSpec(Strict):
                        tempo_control=GOAL_TEMPO if isinstance(task, GoalTask) else None, seed=self.seed,
                        jitter=JITTERS[self.jitter], wrap=wrap)
 
+    @classmethod
+    def of(cls, source: str, **fields) -> "SwimSpec":
+        """A spec from ``fields`` (None: the default); a bad one is one ConfigError line naming
+        ``source`` and the field."""
+        return parse(cls, {k: v for k, v in fields.items() if v is not None}, source)
+
     def with_(self, **changes) -> "SwimSpec":
-        return type(self).model_validate({**self.model_dump(), **changes})
+        return type(self).of("the changed swim", **{**self.model_dump(), **changes})
 
 
 def sph_fields(settings) -> dict | None:

@@ -33,7 +33,7 @@ def test_tiny_analyze_writes_files_that_parse(tmp_path):
         assert (out / png).read_bytes()[:8] == PNG_MAGIC
         assert f"]({png})" in (out / "report.md").read_text()
     config = json.loads((out / "config.json").read_text())
-    assert config["arguments"]["seconds"] == 4.5 and config["log_hz"] == 120
+    assert config["swim"]["seconds"] == 4.5 and config["log_hz"] == 120
 
 
 def test_hand_force_experiment(tmp_path):

@@ -62,7 +62,7 @@ def test_run_json(tmp_path):
     assert {p.name for p in out.iterdir()} == {"summary.json", "config.json", "log.npz", "timeseries.csv",
                                                ".layered-swim-output", ".layered-swim.lock"}
     config = json.loads((out / "config.json").read_text())
-    assert config["arguments"]["seconds"] == 2.0 and config["stroke"]["name"] == "rest"
+    assert config["swim"]["seconds"] == 2.0 and config["stroke"]["name"] == "rest"
     assert config["medium"]["rho_kg_m3"] > 0 and config["physics_hz"] == 480
 
 

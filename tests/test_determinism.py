@@ -4,13 +4,14 @@ import pytest
 
 from layered_swim.control.stroke import available_strokes
 from layered_swim.runs import run_swim
+from layered_swim.spec import SwimSpec
 from layered_swim.recorder import log_hash
 
 SECONDS = 1.5
 
 
-def logged_hash(out_dir, **kwargs) -> str:
-    run_swim(seconds=SECONDS, out_dir=out_dir, **kwargs)
+def logged_hash(out_dir, **fields) -> str:
+    run_swim(SwimSpec(seconds=SECONDS, **fields), out_dir)
     with np.load(out_dir / "log.npz") as log:
         return log_hash(log)
 

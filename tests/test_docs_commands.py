@@ -237,7 +237,9 @@ def check_names(command: Command, args) -> None:
         produced(args.run, "run folder")
     if getattr(args, "policy", None):
         produced(args.policy, "policy")
-    if getattr(args, "config", None):
+    if getattr(args, "config", None) and args.command == "run":      # a run folder's config.json
+        produced(str(Path(args.config).parent), "run folder")
+    elif getattr(args, "config", None):
         assert (REPO / args.config).is_file(), f"{where}: no file {args.config}"
     if getattr(args, "current", None):
         values = args.current.split(",")

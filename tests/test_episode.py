@@ -7,13 +7,18 @@ from layered_swim.control.layered import Layers, fixed_weights
 from layered_swim.control.targets import FixedTarget
 from layered_swim.episode import Episode
 from layered_swim.runs import goal_episode, reach_goal
+from layered_swim.spec import GoalTask, SwimSpec
 from layered_swim.tasks import FollowTarget
 from layered_swim.tasks.follow import TRACK_HZ
 
 
+def _goal(stroke: str) -> SwimSpec:
+    return SwimSpec(stroke=stroke, task=GoalTask(pool="small"))
+
+
 def test_goal_task_moves_its_target_on_reset_without_rebuilding_the_world():
-    episode = goal_episode("small", "front_crawl")
-    fresh = goal_episode("small", "front_crawl")
+    episode = goal_episode(_goal("front_crawl"))
+    fresh = goal_episode(_goal("front_crawl"))
     try:
         world = episode.sim.world
         far = reach_goal(episode, 1)
@@ -27,7 +32,7 @@ def test_goal_task_moves_its_target_on_reset_without_rebuilding_the_world():
 
 
 def test_goal_task_draws_its_goal_from_the_seed():
-    episode = goal_episode("small", "breaststroke")
+    episode = goal_episode(_goal("breaststroke"))
     try:
         drawn = []
         for seed in (3, 3, 4, 5, 6):
@@ -79,9 +84,9 @@ def test_scripted_weights_with_the_rules_on_swim_straight_ahead():
 
 @pytest.mark.parametrize("rho_kg_m3, hip_deg", [(997.05, 0.0), (1023.3, 0.0), (900.0, 20.0), (2500.0, 20.0)])
 def test_the_breaststroke_is_trimmed_only_in_water_far_from_the_body_density(rho_kg_m3, hip_deg):
-    from layered_swim.runs import make_medium
+    from layered_swim.fluid.medium import water
 
-    fresh, other = Episode("breaststroke"), Episode("breaststroke", medium=make_medium(density_kg_m3=rho_kg_m3))
+    fresh, other = Episode("breaststroke"), Episode("breaststroke", medium=water(density_kg_m3=rho_kg_m3))
     try:
         names = other.sim.layout.names
         moved = np.degrees(other.stroke.pose(0.4)[0] - fresh.stroke.pose(0.4)[0])

@@ -15,6 +15,7 @@ from layered_swim import outputs, recorder
 from layered_swim.cli import report_errors
 from layered_swim.recorder import SPOOL_DIR, read_log
 from layered_swim.runs import run_swim
+from layered_swim.spec import SwimSpec
 from test_cli import REPO
 
 CHUNK_ROWS = 6      # a 0.5 s run at 60 Hz: five chunks in the spool, not one per 10 s
@@ -45,7 +46,7 @@ def test_a_full_disk_is_one_line_naming_the_file_and_keeps_the_log(tmp_path, mon
     monkeypatch.setattr(recorder, "atomic_path", _full_disk_at(name))
     monkeypatch.setattr(outputs, "atomic_path", _full_disk_at(name))
     out = tmp_path / "run"
-    assert report_errors("layered-swim", lambda: run_swim("breaststroke", 0.5, out_dir=out)) == 2
+    assert report_errors("layered-swim", lambda: run_swim(SwimSpec(stroke="breaststroke", seconds=0.5), out)) == 2
     failed = out / SPOOL_DIR / name if name.startswith("chunk") else out / name
     where = f"the log so far is kept in {out / kept}" if kept else "no log is kept"
     assert capsys.readouterr().err.splitlines() == [f"layered-swim: error: {failed}: No space left on device; {where}"]

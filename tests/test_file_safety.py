@@ -148,7 +148,7 @@ def test_two_runs_into_one_folder_leave_one_consistent_run(tmp_path):
     assert len(refused.strip().splitlines()) == 1 and "is writing there" in refused
     config = json.loads((out / "config.json").read_text())
     summary = json.loads((out / "summary.json").read_text())
-    assert config["arguments"]["seconds"] == 2.0 and "partial" not in summary
+    assert config["swim"]["seconds"] == 2.0 and "partial" not in summary
     assert not (out / "log.partial").exists()
     assert len(np.load(out / "log.npz")["time_s"]) > 1
 

@@ -9,6 +9,7 @@ from layered_swim.fluid import BACKENDS, FluidBackend, FluidWrenches, make_fluid
 from layered_swim.fluid.buoyancy import buoyancy_wrenches
 from layered_swim.fluid.medium import Medium
 from layered_swim.runs import run_swim
+from layered_swim.spec import SwimSpec
 
 SECONDS = 2.0
 
@@ -27,8 +28,8 @@ class StillWater(FluidBackend):
 
 def test_a_trivial_backend_drives_a_swim_through_run(tmp_path, monkeypatch):
     monkeypatch.setitem(BACKENDS, "still", StillWater)        # the one registry entry
-    run_swim("breaststroke", SECONDS, out_dir=tmp_path / "still", backend="still")
-    run_swim("breaststroke", SECONDS, out_dir=tmp_path / "plate")
+    run_swim(SwimSpec(stroke="breaststroke", seconds=SECONDS, backend="still"), tmp_path / "still")
+    run_swim(SwimSpec(stroke="breaststroke", seconds=SECONDS), tmp_path / "plate")
     still, plate = (np.load(tmp_path / name / "log.npz") for name in ("still", "plate"))
     # Water that pushes nothing sideways gives the limbs nothing to push on: the centre of mass
     # never gains on the stroke's 0.5 m/s start speed (only PyBullet's small default damping

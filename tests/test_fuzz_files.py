@@ -148,9 +148,10 @@ def test_body_files(data, folder):
 def run_folder(tmp_path_factory):
     """A real run folder (a short swim), written once."""
     from layered_swim.runs import run_swim
+    from layered_swim.spec import SwimSpec
 
     out = tmp_path_factory.mktemp("run") / "r"
-    run_swim("breaststroke", 0.5, out_dir=out)
+    run_swim(SwimSpec(stroke="breaststroke", seconds=0.5), out)
     return out
 
 

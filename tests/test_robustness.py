@@ -111,7 +111,7 @@ def test_ctrl_c_keeps_a_readable_partial_log(tmp_path):
     assert analysed.returncode == 0, analysed.stderr
     assert json.loads(analysed.stdout)["cycles"] >= 2
     config = json.loads((tmp_path / "analysis" / "config.json").read_text())
-    assert config["command"] == "analyze" and config["arguments"]["partial_log"] is True
+    assert config["command"] == "analyze" and config["analysis"]["partial_log"] is True
 
 
 def test_a_killed_run_leaves_chunks_that_read_back(tmp_path):

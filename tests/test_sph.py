@@ -254,7 +254,7 @@ def test_the_pool_floor_holds_the_swimmer_and_a_deep_start_pose_is_raised_above_
     assert Episode("breaststroke").sim.fluid.container(sim.state) is None   # open water for the plates
 
     # A limp body dropped in air onto the floor comes to rest on it, not through it.
-    world = World(sim.body, sim.layout, 480)
+    world = World(sim.body, sim.layout, sim.config.physics_hz, sim.config.gravity_m_s2)
     world.reset((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), sim.layout.zeros())
     world.set_pool((-2.0, -2.0, -1.5), (2.0, 2.0, 0.5))
     for _ in range(960):
@@ -275,9 +275,9 @@ def test_goal_on_sph_reports_the_plates_beside(monkeypatch, capsys):
 
     backends = []
 
-    def goal_run(pool, stroke, current, layers, backend="plate", settings=None):
-        backends.append(backend)
-        pos = 0.1 if backend == "sph" else 0.2
+    def goal_run(spec, out_dir=None):
+        backends.append(spec.backend)
+        pos = 0.1 if spec.backend == "sph" else 0.2
         return {"pos_m": pos, "prog": 0.5, "dev_m": 0.1, "roll_deg": 0.0,
                 "goals": [{"goal_m": [1.5, 0.0, -0.05], "pos_m": pos, "prog": 0.5, "dev_m": 0.1, "roll_deg": 0.0}]}
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from layered_swim.body.layout import joint_layout
 from layered_swim.fluid.backend import FluidBackend
-from layered_swim.sim.simulation import PRONE_QUAT_XYZW
+from layered_swim.sim.simulation import GRAVITY_M_S2, PHYSICS_HZ, PRONE_QUAT_XYZW
 from layered_swim.sim.world import World
 from layered_swim.state import BodyState
 
@@ -31,7 +31,7 @@ def glide_state(body) -> BodyState:
     pose = layout.zeros()
     for name, deg in GLIDE_POSE_DEG.items():
         pose[layout.index(name)] = np.radians(deg)
-    world = World(body, layout, physics_hz=480)
+    world = World(body, layout, PHYSICS_HZ, GRAVITY_M_S2)
     try:
         world.reset((0.0, 0.0, -GLIDE_DEPTH_M), PRONE_QUAT_XYZW, pose)
         return world.read_state()

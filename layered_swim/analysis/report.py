@@ -70,10 +70,9 @@ def _value_text(row: dict) -> str:
 
 
 def setting_line(config: dict) -> str:
-    a = config["arguments"]
-    medium = config["medium"]
+    a, medium = config["analysis"], config["medium"]
     return (f"{a['seconds']:g} s swim, fluid density {medium['rho_kg_m3']:g} kg/m^3, current "
-            f"{tuple(medium['current_m_s'])} m/s, physics {config['physics_hz']} Hz, seed {a['seed']}; "
+            f"{tuple(medium['current_m_s'])} m/s, physics {config['physics_hz']} Hz, seed {config['swim']['seed']}; "
             f"analysed after a {a['settle_s']:g} s settle time")
 
 

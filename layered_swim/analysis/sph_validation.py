@@ -33,9 +33,10 @@ from layered_swim.fluid.sph import SphSettings
 from layered_swim.fluid.backend import FluidError
 from layered_swim.fluid.sph.backend import HEADROOM_M, MAX_WATER_SPEED_M_S, boundary_boxes, start_request
 from layered_swim.fluid.sph.worker import SphWorker
+from layered_swim.sim.simulation import GRAVITY_M_S2
 
 WINDOW_S = 0.02
-G_M_S2 = 9.81
+G_M_S2 = GRAVITY_M_S2
 TORSO_HALF_M = np.array([0.15, 0.175, 0.275])       # 0.30 x 0.35 x 0.55 m: pelvis to shoulders
 PLATE_HALF_M = np.array([0.15, 0.15, 0.025])        # 0.30 x 0.30 m, thin along its local z
 FLOAT_HALF_M = np.array([0.15, 0.15, 0.10])         # 0.30 x 0.30 x 0.20 m at 500 kg/m^3: 0.10 m draft

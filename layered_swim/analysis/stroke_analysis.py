@@ -19,12 +19,12 @@ from layered_swim.analysis.stroke_metrics import SwimmerInfo, analyze_log
 from layered_swim.analysis.sweep import file_sha256, run_sweep
 from layered_swim.config import ConfigError, load_json
 from layered_swim.control.stroke import stroke_path
-from layered_swim.episode import Episode
 from layered_swim.fluid import make_fluid
-from layered_swim.fluid.sph import SphSettings
 from layered_swim.outputs import COMMAND_KEY, OutputFolder, claim, write_json, write_text
 from layered_swim.recorder import logged_names, read_log
-from layered_swim.runs import check_seconds, make_medium, record, resolved_config
+from layered_swim.runs import check_seconds, record, resolved_config
+from layered_swim.sim.simulation import PHYSICS_HZ
+from layered_swim.spec import SwimSpec
 
 ANALYSIS_LOG_HZ = 120      # ~100 samples per stroke cycle for the profiles
 PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_figure,
@@ -33,7 +33,7 @@ PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_fi
 
 def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | None = None,
                     current_m_s=(0.0, 0.0, 0.0), fluid: str = "fresh_water", settle_s: float = SETTLE_S,
-                    seed: int = 0, physics_hz: int = 480, backend: str = "plate", sph: dict | None = None) -> dict:
+                    seed: int = 0, physics_hz: int | None = None, backend: str = "plate", sph: dict | None = None) -> dict:
     """The resolved, JSON-able configuration of one analysis (also its cache key); ``sph``: the
     SPH settings' fields, with ``backend="sph"``."""
     check_seconds(seconds)
@@ -41,25 +41,24 @@ def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | N
         raise ConfigError(f"settle time must be at least 0 and shorter than the swim ({seconds:g} s), got {settle_s}")
     return {"stroke": stroke, "stroke_file_sha256": file_sha256(stroke_path(stroke)), "seconds": float(seconds),
             "density_kg_m3": density_kg_m3, "current_m_s": [float(c) for c in current_m_s], "fluid": fluid,
-            "settle_s": float(settle_s), "seed": seed, "physics_hz": physics_hz, "backend": backend, "sph": sph}
+            "settle_s": float(settle_s), "seed": seed, "physics_hz": physics_hz or PHYSICS_HZ, "backend": backend, "sph": sph}
 
 
-def analysis_episode(config: dict) -> Episode:
-    """The episode ``config`` swims; building it checks every file and setting of the config."""
-    medium = make_medium(config["fluid"], config["density_kg_m3"], config["current_m_s"])
-    return Episode(config["stroke"], medium=medium, physics_hz=config["physics_hz"], seed=config["seed"],
-                   backend=config.get("backend", "plate"), fluid_settings=_sph_settings(config))
-
-
-def _sph_settings(config: dict) -> SphSettings | None:
-    return SphSettings(**config["sph"]) if config.get("sph") else None
+def analysis_spec(config: dict) -> SwimSpec:
+    """The swim ``config`` analyses: free swimming, logged at ``ANALYSIS_LOG_HZ``."""
+    return SwimSpec.of("the analysis", stroke=config["stroke"], seconds=config["seconds"],
+                       medium={"fluid": config["fluid"], "density_kg_m3": config["density_kg_m3"],
+                               "current_m_s": config["current_m_s"]},
+                       backend=config.get("backend", "plate"), sph=config.get("sph"), physics_hz=config["physics_hz"],
+                       log_hz=ANALYSIS_LOG_HZ, seed=config["seed"])
 
 
 def analyze_stroke(config: dict, progress: bool = False) -> dict:
-    episode = analysis_episode(config)
-    settings = _sph_settings(config)
+    spec = analysis_spec(config)
+    episode = spec.episode()
+    settings = spec.fluid_settings()
     sim, stroke = episode.sim, episode.stroke
-    recorder = record(episode, config["seconds"], ANALYSIS_LOG_HZ, progress, joint_work=True)
+    recorder = record(episode, spec.seconds, spec.log_hz, progress, joint_work=True)
     posture = stroke.start.posture
     result = analyze_log(recorder.arrays(), SwimmerInfo(sim.body.segment_names, posture, stroke.period_s,
                                                         config["settle_s"]))
@@ -72,7 +71,13 @@ def analyze_stroke(config: dict, progress: bool = False) -> dict:
                                  if posture == "prone" and towed is not None else None)
     summary["nominal_stroke_rate_cpm"] = 60.0 / stroke.period_s
     return {"stroke": stroke.name, "posture": posture, **result,
-            "config": resolved_config(episode, config, ANALYSIS_LOG_HZ, "analyze")}
+            "config": resolved_config(episode, spec, "analyze", analysis=_settings(config["seconds"], config["settle_s"],
+                                                                             stroke_file_sha256=config["stroke_file_sha256"]))}
+
+
+def _settings(seconds: float, settle_s: float, **more) -> dict:
+    """config.json's ``analysis`` section: what was analysed of the swim, and how."""
+    return {"seconds": seconds, "settle_s": settle_s, **more}
 
 
 def analyze_run(run_dir: str | Path, settle_s: float = SETTLE_S) -> dict:
@@ -82,7 +87,8 @@ def analyze_run(run_dir: str | Path, settle_s: float = SETTLE_S) -> dict:
     config_path = run_dir / "config.json"
     config = load_json(config_path)
     try:
-        spec, tempo = config["stroke"], float(config["arguments"]["tempo"])
+        swim = config.get("swim") or config["arguments"]          # "arguments": an older version's folder
+        spec, tempo = config["stroke"], float(swim["tempo"])
         name, posture, period_s = str(spec["name"]), str(spec["start"]["posture"]), float(spec["period_s"]) / tempo
     except (KeyError, TypeError, ValueError, ZeroDivisionError):
         raise ConfigError(f"{config_path}: not the config of a `layered-swim run` folder (no stroke, posture, "
@@ -95,10 +101,9 @@ def analyze_run(run_dir: str | Path, settle_s: float = SETTLE_S) -> dict:
     arrays = {name: log[name] for name in logged_names(log)}
     result = analyze_log(arrays, SwimmerInfo(tuple(str(n) for n in log["segment_names"]), posture, period_s, settle_s))
     result["summary"]["nominal_stroke_rate_cpm"] = 60.0 / period_s
-    arguments = {**config["arguments"], "seconds": float(log["time_s"][-1]), "settle_s": settle_s,
-                 "run_dir": str(run_dir), "partial_log": bool(log["partial"]) or _stopped_early(run_dir)}
-    return {"stroke": name, "posture": posture, **result,
-            "config": {**config, COMMAND_KEY: "analyze", "arguments": arguments}}
+    analysis = _settings(float(log["time_s"][-1]), settle_s, run_dir=str(run_dir),
+                         partial_log=bool(log["partial"]) or _stopped_early(run_dir))
+    return {"stroke": name, "posture": posture, **result, "config": {**config, COMMAND_KEY: "analyze", "analysis": analysis}}
 
 
 def _stopped_early(run_dir: Path) -> bool:

@@ -14,7 +14,7 @@ def add_parser(subparsers) -> None:
     bench.add_argument("--seconds", type=float, help="simulated seconds per repeat (default 5; 0.5 with SPH; 10 with --env)")
     bench.add_argument("--env", action="store_true", help="time the RL environment: steps per second on one core and "
                                                           "the shares of physics, observation, reward and policy ([rl] extra)")
-    bench.add_argument("--physics-hz", type=int, default=480)
+    bench.add_argument("--physics-hz", type=int, help="physics rate in Hz (default 480)")
     backend_option(bench)
 
 

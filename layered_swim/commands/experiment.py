@@ -36,8 +36,9 @@ def run(args) -> None:
         from layered_swim.body.model import load_body
         from layered_swim.fluid import make_fluid
         from layered_swim.fluid.medium import Medium
+        from layered_swim.sim.simulation import GRAVITY_M_S2
 
-        make_fluid(args.backend, load_body(), Medium(), 9.81, settings)
+        make_fluid(args.backend, load_body(), Medium(), GRAVITY_M_S2, settings)
     summary = run_experiment(module, out, quick=args.quick, workers=args.workers, progress=progress(args),
                              seed=args.seed, backend=args.backend, fluid_settings=settings)
     if args.json:

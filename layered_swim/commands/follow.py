@@ -4,8 +4,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from layered_swim.commands.options import (backend_option, count, fluid_settings, out_dir, overwrite_option,
-                                           parallel_options, progress, steering_options, vector)
+from layered_swim.commands.options import (backend_option, count, medium, out_dir, overwrite_option, parallel_options,
+                                           progress, steering_options, swim_spec)
 from layered_swim.commands.tables import fmt, table
 
 
@@ -29,43 +29,34 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> None:
-    from layered_swim.control.layered import Layers
+    from layered_swim.learned import steering_for
     from layered_swim.runs import default_out_dir, follow_run
 
-    layers, steered = Layers.parse(args.layers), {}
+    spec = swim_spec(args, args.stroke, {"kind": "follow", "trajectory": args.trajectory}, seconds=args.seconds,
+                     medium=medium(args), layers=args.layers, policy=args.policy)
     if args.seeds is not None:
-        _follow_seeds(args, layers)
+        _follow_seeds(args, spec)
         return
-    if args.policy:        # the residual on its own reference controller, run by its driver
-        from layered_swim.rl.policy import follow_steering
-
-        layers, steered = follow_steering(args.policy, args.stroke)
     out = out_dir(args, default_out_dir(f"follow-{Path(args.trajectory).stem}"))
-    result = follow_run(args.trajectory, args.stroke, layers, vector(args.current, "--current"),
-                        args.density, args.seconds, out, args.backend, fluid_settings(args), **steered)
+    result = follow_run(spec, out, steering_for(spec))
     if args.json:
         print(json.dumps({**result, "out_dir": str(out.path)}, allow_nan=False))
         return
     rows = {k: v for k, v in result.items() if not isinstance(v, dict)}
     rows.update({f"swim.{k}": v for k, v in result.get("swim_metrics", {}).items() if v is not None})
     print(table([[k, fmt(v)] for k, v in rows.items()]))
-    print(f"\nwrote summary.json, config.json, track.npz, log.npz to {out.path}")
+    print(f"\nwrote summary.json, config.json, track.npz, log.npz, timeseries.csv to {out.path}")
 
 
-def _follow_seeds(args, layers) -> None:
+def _follow_seeds(args, spec) -> None:
     from layered_swim.analysis.robustness import follow_seeds
     from layered_swim.config import ConfigError
     from layered_swim.runs import default_out_dir
 
     if args.backend != "plate":
         raise ConfigError("--seeds runs on the plate backend only (no --backend sph)")
-    if args.policy:
-        from layered_swim.rl.policy import follow_steering
-
-        layers = follow_steering(args.policy, args.stroke)[0]     # fails here, in one line, not in every worker
     out = out_dir(args, default_out_dir(f"follow-{Path(args.trajectory).stem}-seeds"))
-    summary = follow_seeds(args.trajectory, args.stroke, layers, vector(args.current, "--current"), args.density,
-                           args.seconds, args.seeds, out, args.workers, progress(args), policy=args.policy)
+    summary = follow_seeds(spec, args.seeds, out, args.workers, progress(args))
     if args.json:
         print(json.dumps({**summary, "out_dir": str(out.path)}, allow_nan=False))
         return

@@ -46,7 +46,7 @@ def water_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--seed", type=int, default=0,
                          help="0 (default): the stroke's exact start; any other: a start jittered by it "
                               "(heading, speed, depth, position; see README)")
-    command.add_argument("--physics-hz", type=int, default=480)
+    command.add_argument("--physics-hz", type=int, help="physics rate in Hz (default 480)")
 
 
 def backend_option(command: argparse.ArgumentParser, pool: str | None = "small") -> None:
@@ -72,6 +72,22 @@ def fluid_settings(args):
 
     return sph_settings_for(args.pool, args.water_depth, particle_radius_m=args.particle_radius,
                             threads=args.threads, deterministic=args.deterministic)
+
+
+def swim_spec(args, stroke: str, task: dict, **fields):
+    """The command line's swim as a ``SwimSpec``: ``task`` and ``fields`` (None: the spec's
+    default) with the backend options; a bad value is one line naming its field."""
+    from layered_swim.spec import SwimSpec, sph_fields
+
+    return SwimSpec.of("the command line", stroke=stroke, task=task, backend=args.backend,
+                       sph=sph_fields(fluid_settings(args)), **fields)
+
+
+def medium(args, current: bool = True) -> dict:
+    """``SwimSpec.medium`` from --fluid, --density and --current (those the command has)."""
+    water = {"fluid": getattr(args, "fluid", None), "density_kg_m3": getattr(args, "density", None),
+             "current_m_s": vector(args.current, "--current") if current and hasattr(args, "current") else None}
+    return {k: v for k, v in water.items() if v is not None}
 
 
 def current_option(command: argparse.ArgumentParser) -> None:
@@ -105,7 +121,7 @@ def analysis_config(args, stroke: str) -> dict:
     config = stroke_analysis.analysis_config(stroke, args.seconds, args.density, vector(args.current, "--current"),
                                              args.fluid, args.settle, args.seed, args.physics_hz, args.backend,
                                              None if settings is None else asdict(settings))
-    stroke_analysis.analysis_episode(config).close()
+    stroke_analysis.analysis_spec(config).episode().close()
     return config
 
 

@@ -24,14 +24,14 @@ def run(args) -> None:
     from layered_swim.config import ConfigError
     from layered_swim.fluid import make_fluid
     from layered_swim.fluid.medium import Medium
-    from layered_swim.sim.simulation import SimConfig
+    from layered_swim.sim.simulation import GRAVITY_M_S2
 
     if args.what == "sph":
         return _validate_sph(args)
     if args.backend != "plate":
         raise ConfigError("validate drag reads a memoryless fluid in one evaluation; "
                           "the SPH water is validated by `validate sph`")
-    rows = towed_drag(make_fluid(args.backend, load_body(), Medium(), SimConfig().gravity_m_s2))
+    rows = towed_drag(make_fluid(args.backend, load_body(), Medium(), GRAVITY_M_S2))
     if args.json:
         print(json.dumps(rows))
         return
@@ -45,9 +45,10 @@ def _validate_sph(args) -> None:
     from layered_swim.fluid import make_fluid
     from layered_swim.body.model import load_body
     from layered_swim.fluid.medium import Medium
+    from layered_swim.sim.simulation import GRAVITY_M_S2
 
     settings = fluid_settings(argparse.Namespace(**{**vars(args), "backend": "sph"}))
-    make_fluid("sph", load_body(), Medium(), 9.81, settings)       # the extra is installed, the settings valid
+    make_fluid("sph", load_body(), Medium(), GRAVITY_M_S2, settings)       # the extra is installed, the settings valid
     say = None if args.json else (lambda text: print(f"... {text}", file=sys.stderr))
     result = validate_sph(settings, progress=say)
     if args.json:

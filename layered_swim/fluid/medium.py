@@ -42,6 +42,12 @@ class Medium:
         return replace(self, **changes)
 
 
+def water(fluid: str = "fresh_water", density_kg_m3: float | None = None, current_m_s=(0.0, 0.0, 0.0)) -> Medium:
+    """A preset's water, optionally at another density, with a current."""
+    medium = preset(fluid).with_(current_m_s=tuple(float(c) for c in current_m_s))
+    return medium if density_kg_m3 is None else medium.with_(rho_kg_m3=float(density_kg_m3))
+
+
 def preset(name: str) -> Medium:
     try:
         rho, eta = PRESETS_KG_M3_PA_S[name]

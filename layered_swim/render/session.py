@@ -12,7 +12,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from layered_swim.render.scene import Scene
-from layered_swim.config import ConfigError
 from layered_swim.control.calibration import CalibrationError
 from layered_swim.control.layered import Layers
 from layered_swim.control.steering import attitude_of
@@ -21,8 +20,8 @@ from layered_swim.control.stroke import available_strokes, stroke_path
 from layered_swim.control.targets import MovableTarget, TrajectoryTarget, load_trajectory
 from layered_swim.episode import Episode
 from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S
-from layered_swim.runs import make_medium
-from layered_swim.sim.simulation import SimulationDiverged
+from layered_swim.fluid.medium import water
+from layered_swim.sim.simulation import PHYSICS_HZ, SimulationDiverged
 from layered_swim.tasks import FollowTarget
 
 CURRENT_PRESETS_M_S = (("none", (0.0, 0.0, 0.0)), ("0.3 m/s cross", (0.0, 0.3, 0.0)),
@@ -76,7 +75,7 @@ class ActiveTarget:
 
 class SwimSession:
     def __init__(self, stroke: str = "breaststroke", layers: Layers = Layers(), current_m_s=(0.0, 0.0, 0.0),
-                 density_kg_m3: float | None = None, trajectory: str | None = None, physics_hz: int = 480,
+                 density_kg_m3: float | None = None, trajectory: str | None = None, physics_hz: int = PHYSICS_HZ,
                  backend: str = "plate", fluid_settings=None, policy=None):
         self.strokes = available_strokes() + [AUTO]
         if stroke != AUTO:
@@ -86,8 +85,7 @@ class SwimSession:
         # A learned residual (rl.policy.Policy) drives its own stroke on its own reference controller.
         self.policy = policy
         if policy is not None:
-            if stroke != policy.env["stroke"]:
-                raise ConfigError(f"the policy was trained for {policy.env['stroke']}; use --stroke {policy.env['stroke']}")
+            policy.check_stroke(stroke)
             self.strokes = [stroke]
         self.currents, self.current_index = _presets(CURRENT_PRESETS_M_S, tuple(current_m_s), "custom current")
         density = DENSITY_PRESETS_KG_M3[0][1] if density_kg_m3 is None else float(density_kg_m3)
@@ -109,8 +107,8 @@ class SwimSession:
 
     # --- building ----------------------------------------------------------------------
     def _medium(self):
-        return make_medium(density_kg_m3=self.densities[self.density_index].value,
-                           current_m_s=self.currents[self.current_index].value)
+        return water(density_kg_m3=self.densities[self.density_index].value,
+                     current_m_s=self.currents[self.current_index].value)
 
     def _build(self, stroke: str, position_xy_m, heading_rad: float, use_start_speed: bool) -> None:
         old = getattr(self, "episode", None)
@@ -136,15 +134,11 @@ class SwimSession:
         self._record_trail()
 
     def _policy_episode(self, stroke: str, task) -> Episode:
-        from layered_swim.control.residual import ResidualController
-        from layered_swim.rl.env import REFERENCES
-        from layered_swim.rl.policy import ResidualDriver
-
+        steering = self.policy.steering(stroke)
         self.cycle_available = True
-        episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz,
-                          layers=Layers.parse(REFERENCES[self.policy.env["reference"]]), backend=self.backend,
-                          fluid_settings=self.fluid_settings, wrap=ResidualController)
-        self._driver = ResidualDriver(self.policy, episode)
+        episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=steering.layers,
+                          backend=self.backend, fluid_settings=self.fluid_settings, wrap=steering.wrap)
+        self._driver = steering.driver(episode)
         return episode
 
     def _episode(self, stroke: str, task) -> Episode:

@@ -25,13 +25,13 @@ import gymnasium as gym
 import numpy as np
 
 from layered_swim.config import ConfigError
-from layered_swim.control.layered import Layers
 from layered_swim.control.residual import ResidualController
 from layered_swim.control.steering import attitude_of
 from layered_swim.fluid import FluidError
 from layered_swim.rl import observation as obs
 from layered_swim.rl.reward import BODY_POINT_WEIGHTS, RewardWeights, reward_parts
 from layered_swim.runs import goal_episode
+from layered_swim.spec import SwimSpec, sph_fields
 from layered_swim.sim.simulation import SimulationDiverged
 from layered_swim.tasks import swim_benchmark as bench
 
@@ -100,8 +100,10 @@ class SwimGoalEnv(gym.Env):
         self.pool = bench.pool(pool)
         self.reference, self.env_state, self.action_scale_rad = reference, env_state, float(action_scale_rad)
         self.reward_weights, self.fixed_goal, self.start_jitter = reward_weights, goal, start_jitter
-        self.episode = goal_episode(pool, stroke, current_m_s, Layers.parse(REFERENCES[reference]), backend,
-                                    fluid_settings, wrap=ResidualController)
+        spec = SwimSpec.of("the environment", stroke=stroke, task={"kind": "goal", "pool": pool},
+                           medium={"current_m_s": current_m_s}, layers=REFERENCES[reference], backend=backend,
+                           sph=sph_fields(fluid_settings))
+        self.episode = goal_episode(spec, wrap=ResidualController)
         sim = self.episode.sim
         if not (isinstance(policy_hz, int) and policy_hz > 0 and sim.config.physics_hz % policy_hz == 0
                 and (sim.config.physics_hz // policy_hz) % sim.control_every == 0):

@@ -5,6 +5,7 @@ running it on SWIM's goal task (``evaluate_goals``) and inside any other episode
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Callable, NamedTuple
 
 import numpy as np
 import torch
@@ -21,6 +22,15 @@ POLICY_FORMAT = 1
 POLICY_KEYS = ("format", "model_args", "model", "normaliser", "env", "reward")
 MAX_POLICY_BYTES = 256 * 2**20      # the shipped policy is 1 MB; hidden [4096, 4096] about 140 MB
 MAX_IO_SIZE = 10_000                # observations or actions (the body gives 255 and 33)
+
+
+class Steering(NamedTuple):
+    """A learned residual in charge of an episode (``Policy.steering``)."""
+
+    layers: object          # the reference controller's layers (control.layered.Layers)
+    wrap: Callable          # Episode's wrap: the residual's controller around the reference
+    driver: Callable        # episode -> the observer that sets the residual every policy step
+    summary: dict           # what a run's summary says of it
 
 
 class Policy:
@@ -71,23 +81,22 @@ class Policy:
             raise ConfigError(f"{self.source} expects {self.model_args[0]} observations and {self.model_args[1]} "
                               f"actions, {where} has {n_obs} and {n_act}")
 
+    def steering(self, stroke: str | None = None) -> "Steering":
+        """How this residual takes charge of an episode of ``stroke`` (None: its own; another is
+        refused): build the episode with ``layers`` (its reference controller) and ``wrap``
+        around it, then observe it with ``driver(episode)``."""
+        from layered_swim.control.layered import Layers
+        from layered_swim.control.residual import ResidualController
+        from layered_swim.rl.env import REFERENCES
+
+        self.check_stroke(stroke)
+        reference = self.env["reference"]
+        return Steering(Layers.parse(REFERENCES[reference]), ResidualController,
+                        lambda episode: ResidualDriver(self, episode), {"policy": self.source, "reference": reference})
+
     def env_kwargs(self, **changes) -> dict:
         """The training environment's arguments, with ``changes`` (backend, pool, current...)."""
         return env_arguments(self.env, self.reward, **changes)
-
-
-def follow_steering(policy_path: str | Path, stroke: str):
-    """The layers and ``follow_run`` arguments that put the residual in ``policy_path`` in charge
-    of a follow swim: its own reference controller, driven by ``ResidualDriver``."""
-    from layered_swim.control.layered import Layers
-    from layered_swim.control.residual import ResidualController
-    from layered_swim.rl.env import REFERENCES
-
-    policy = Policy.load(policy_path)
-    policy.check_stroke(stroke)
-    return Layers.parse(REFERENCES[policy.env["reference"]]), {
-        "wrap": ResidualController, "driver": lambda episode: ResidualDriver(policy, episode),
-        "extra": {"policy": str(policy_path), "reference": policy.env["reference"]}}
 
 
 def model_arguments(value, source) -> tuple:

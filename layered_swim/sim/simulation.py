@@ -8,7 +8,7 @@ that calls ``step``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Protocol
 
 import numpy as np
@@ -54,9 +54,9 @@ class Controller(Protocol):
 
 @dataclass(frozen=True)
 class SimConfig:
-    physics_hz: int = 480
-    control_hz: int = 120
-    gravity_m_s2: float = 9.81
+    physics_hz: int
+    control_hz: int
+    gravity_m_s2: float
 
     def __post_init__(self):
         if self.physics_hz < 120 or self.physics_hz > 5000:
@@ -66,9 +66,17 @@ class SimConfig:
         if not (math.isfinite(self.gravity_m_s2) and 0.0 <= self.gravity_m_s2 <= 100.0):
             raise ConfigError(f"gravity must be in 0..100 m/s^2, got {self.gravity_m_s2}")
 
+    def at(self, physics_hz: int) -> "SimConfig":
+        return replace(self, physics_hz=physics_hz)
+
+
+# The rates and gravity of every swim unless it asks otherwise: written here only.
+DEFAULT_SIM = SimConfig(physics_hz=480, control_hz=120, gravity_m_s2=9.81)
+PHYSICS_HZ, GRAVITY_M_S2 = DEFAULT_SIM.physics_hz, DEFAULT_SIM.gravity_m_s2
+
 
 class Simulation:
-    def __init__(self, body: Body, controller: Controller, fluid: FluidBackend, config: SimConfig = SimConfig(),
+    def __init__(self, body: Body, controller: Controller, fluid: FluidBackend, config: SimConfig = DEFAULT_SIM,
                  layout: JointLayout | None = None, pd_gain_scale: dict[str, float] | None = None):
         self.body = body
         self.layout = layout or joint_layout(body)

@@ -86,7 +86,7 @@ def _tree(client, uid: int) -> Tree:
 
 
 class World:
-    def __init__(self, body: Body, layout: JointLayout, physics_hz: float, gravity_m_s2: float = 9.81,
+    def __init__(self, body: Body, layout: JointLayout, physics_hz: float, gravity_m_s2: float,
                  pd_gain_scale: dict[str, float] | None = None):
         self.body = body
         self.layout = layout

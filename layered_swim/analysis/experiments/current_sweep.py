@@ -14,7 +14,8 @@ from layered_swim.analysis.files import write_csv
 from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import load_body
 from layered_swim.control.stroke import load_stroke
-from layered_swim.runs import GOAL_TEMPO, goal_episode, reach_goal
+from layered_swim.runs import goal_episode, reach_goal
+from layered_swim.spec import GOAL_TEMPO, SwimSpec
 from layered_swim.tasks.goal import GOAL_METRICS
 
 NAME = "current-sweep"
@@ -45,7 +46,8 @@ def configs(quick: bool, seed: int) -> list[dict]:
 
 
 def run(config: dict) -> dict:
-    episode = goal_episode(config["pool"], config["stroke"], tuple(config["current_m_s"]))
+    episode = goal_episode(SwimSpec.of("current-sweep", stroke=config["stroke"], task={"kind": "goal", "pool": config["pool"]},
+                                       medium={"current_m_s": config["current_m_s"]}))
     try:
         metrics = reach_goal(episode, config["goal"])
     finally:

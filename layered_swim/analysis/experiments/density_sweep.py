@@ -13,7 +13,8 @@ from layered_swim.analysis.files import write_csv
 from layered_swim.control.targets import load_trajectory
 from layered_swim.episode import Episode
 from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S
-from layered_swim.runs import make_medium, swim
+from layered_swim.fluid.medium import water
+from layered_swim.runs import swim
 from layered_swim.sim.simulation import SimulationDiverged
 from layered_swim.tasks import FollowTarget
 from layered_swim.tasks.follow import TRACK_HZ
@@ -46,7 +47,7 @@ def configs(quick: bool, seed: int) -> list[dict]:
 def run(config: dict) -> dict:
     try:
         task = FollowTarget(load_trajectory(config["trajectory"]))
-        swim(Episode(config["stroke"], task, medium=make_medium(density_kg_m3=config["density_kg_m3"])), config["seconds"])
+        swim(Episode(config["stroke"], task, medium=water(density_kg_m3=config["density_kg_m3"])), config["seconds"])
     except SimulationDiverged as err:
         return {"diverged": str(err)}
     a = task.track()

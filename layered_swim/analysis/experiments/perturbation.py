@@ -19,6 +19,7 @@ from layered_swim.body.model import load_body
 from layered_swim.control.targets import load_trajectory
 from layered_swim.episode import Episode
 from layered_swim.runs import swim
+from layered_swim.sim.simulation import GRAVITY_M_S2
 from layered_swim.tasks import FollowTarget
 
 NAME = "perturbation"
@@ -75,7 +76,7 @@ def push(config: dict, weight_n: float):
 
 def run(config: dict) -> dict:
     body = load_body()
-    weight_n = float(body.total_mass_kg * 9.81)
+    weight_n = float(body.total_mass_kg * GRAVITY_M_S2)
     pusher = push(config, weight_n)
     episode = swim(Episode(config["stroke"], FollowTarget(load_trajectory(config["trajectory"]))), config["seconds"],
                    observers=[pusher] if pusher else [])
@@ -166,7 +167,7 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
         + (f"; on average off track (beyond {threshold:.2f} m) from {min(random_off):g} N." if random_off
            else f"; on average on track (within {threshold:.2f} m) up to {randoms[-1][0]:g} N."))
     setting = (f"{STROKE}, all three layers, following `{TRAJECTORY}` (0.5 m/s) for {SECONDS:g} s. Impulses: a force of "
-               f"k mg (m = {results[0]['weight_n'] / 9.81:.1f} kg) on the pelvis for {IMPULSE_S:g} s at t = {PUSH_AT_S:g} s. "
+               f"k mg (m = {results[0]['weight_n'] / GRAVITY_M_S2:.1f} kg) on the pelvis for {IMPULSE_S:g} s at t = {PUSH_AT_S:g} s. "
                f"Random pushes: constant magnitude from t = {RANDOM_FROM_S:g} s, direction drawn uniformly on the sphere "
                f"every {RANDOM_HOLD_S:g} s (seeded). On track = within the unperturbed run's largest distance to the "
                f"target after {RANDOM_FROM_S:g} s ({threshold - BACK_ON_TRACK_M:.2f} m) plus {BACK_ON_TRACK_M:g} m; the "

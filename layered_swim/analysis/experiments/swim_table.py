@@ -51,8 +51,8 @@ def configs(quick: bool, seed: int) -> list[dict]:
 
 
 def run(config: dict) -> dict:
-    from layered_swim.control.layered import Layers
     from layered_swim.runs import goal_episode, reach_goal, sph_settings_for
+    from layered_swim.spec import SwimSpec, sph_fields
 
     residual, fluid = config["residual"], config["fluid"]
     if residual and config["policy_sha256"] is None:
@@ -65,8 +65,8 @@ def run(config: dict) -> dict:
             scores = evaluate_goals(Policy.load(policy_file(residual)), seeds=1, goals=[config["goal"]],
                                     backend=fluid, fluid_settings=settings)
             return {k: scores[k] for k in GOAL_METRICS}
-        episode = goal_episode(POOL, STROKE, layers=Layers.parse(config["layers"]), backend=fluid,
-                               fluid_settings=settings)
+        episode = goal_episode(SwimSpec.of("swim-table", stroke=STROKE, task={"kind": "goal", "pool": POOL},
+                                           layers=config["layers"], backend=fluid, sph=sph_fields(settings)))
     except ConfigError as err:       # the [sph] or [rl] extra missing: a row that says so
         return {"missing": str(err)}
     try:
