@@ -14,13 +14,29 @@ import re
 import signal
 import sys
 
-from layered_swim.commands import (PROG, analyze, app, bench, calibrate, compare, experiment, follow, goal, render,
-                                   run, soak, strokes, train, validate)
+from layered_swim.commands import (
+    PROG,
+    analyze,
+    app,
+    bench,
+    calibrate,
+    compare,
+    experiment,
+    export,
+    follow,
+    goal,
+    render,
+    run,
+    soak,
+    strokes,
+    train,
+    validate,
+)
 
 # In the order `layered-swim --help` lists them.
 COMMANDS = {module.__name__.rpartition(".")[2]: module
-            for module in (run, strokes, validate, calibrate, follow, goal, render, analyze, compare, experiment,
-                           train, soak, bench, app)}
+            for module in (run, strokes, validate, calibrate, follow, goal, render, export, analyze, compare,
+                           experiment, train, soak, bench, app)}
 
 
 class OneLineParser(argparse.ArgumentParser):

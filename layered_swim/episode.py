@@ -14,11 +14,12 @@ After dm_control's Physics / Task / Environment split and Gymnasium's ``reset(se
 
 ``stroke="auto"`` builds a layered controller for each of ``AUTO_STROKES`` and lets
 ``control/auto.py`` switch between them; the start is the first one's. Which controller drives
-the swimmer: ``weights`` (a scripted per-cycle policy) gives the
-layered controller with those weights; otherwise a task without a target gets the basic stroke
-alone, and a task with one gets the layered controller steering toward it (``layers`` says
-which layers are on; the per-cycle layer reads the stroke's calibration table). ``wrap`` puts
-another controller around that one (the RL environment's learned residual).
+the swimmer: ``weights`` (a ``CycleChooser``, e.g. ``fixed_weights``: scripted per-cycle
+weights) gives the layered controller with that chooser; otherwise a task without a target gets
+the basic stroke alone, and a task with one gets the layered controller steering toward it
+(``TargetChooser``; ``layers`` says which layers are on; the per-cycle layer reads the stroke's
+calibration table). ``wrap`` puts another controller around that one (the RL environment's
+learned residual).
 """
 from __future__ import annotations
 
@@ -37,9 +38,9 @@ from layered_swim.config import ConfigError, load
 from layered_swim.control.auto import AUTO, AUTO_STROKES, AutoStrokeController
 from layered_swim.control.basic import StrokeController
 from layered_swim.control.calibration import load_table
-from layered_swim.control.layered import Layers, LayeredController, WeightPolicy, fixed_weights
+from layered_swim.control.cycle_choice import TargetChooser, TempoControl
+from layered_swim.control.layered import CycleChooser, LayeredController, Layers, fixed_weights
 from layered_swim.control.lungs import LungControl
-from layered_swim.control.policy import TargetPolicy, TempoControl
 from layered_swim.control.rules import arm_indices
 from layered_swim.control.steering import SteeringGains
 from layered_swim.control.stroke import LEVEL_OFF, Stroke, StrokeSpec, build_stroke, stroke_path
@@ -71,7 +72,7 @@ WIDE_JITTER = StartJitter(heading_rad=math.radians(10.0), position_m=0.3)
 class Episode:
     def __init__(self, stroke: str, task: Task | None = None, *, medium: Medium = Medium(), backend: str = "plate",
                  fluid_settings=None, lung_air_l: float | None = None, physics_hz: int = PHYSICS_HZ, tempo: float = 1.0,
-                 layers: Layers = Layers(), weights: WeightPolicy | None = None,
+                 layers: Layers = Layers(), weights: CycleChooser | None = None,
                  tempo_control: TempoControl | None = None, seed: int = 0, jitter: StartJitter = START_JITTER,
                  wrap: Callable[[object, JointLayout], object] | None = None):
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
@@ -204,7 +205,7 @@ def jittered_start(start: Start, rng: np.random.Generator, jitter: StartJitter =
                    position_xy_m=(start.position_xy_m[0] + dx, start.position_xy_m[1] + dy))
 
 
-def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Layers, weights: WeightPolicy | None,
+def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Layers, weights: CycleChooser | None,
                 tempo: float, tempo_control: TempoControl | None):
     if weights is None and target is None:
         return StrokeController(stroke, tempo)
@@ -217,8 +218,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                   over_weight_within_rad=math.radians(steer.over_weight_within_deg))
             level_off = (math.radians(steer.level_off_beyond_deg)
                          if LEVEL_OFF in stroke.perturbations and lying(stroke.start.posture) else None)
-            weights = TargetPolicy(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,
-                                   level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo)
+            weights = TargetChooser(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,
+                                    level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo)
         else:
             weights = fixed_weights({}, tempo=tempo)
     lungs = LungControl(body.lung_air_l, body.max_lung_air_l) if stroke.steering.breathe else None

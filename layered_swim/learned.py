@@ -9,6 +9,6 @@ def steering_for(spec):
     another stroke); None for a swim without a policy."""
     if spec.policy is None:
         return None
-    from layered_swim.rl.policy import Policy
+    from layered_swim.rl.policy import ResidualPolicy
 
-    return Policy.load(spec.policy).steering(spec.stroke)
+    return ResidualPolicy.load(spec.policy).steering(spec.stroke)

@@ -179,7 +179,8 @@ class Recorder:
             for name in logged_names(first):      # one array at a time: each pass reads only it
                 with archive.open(_member(name), "w", force_zip64=True) as member:
                     shape = (rows, *first[name].shape[1:])
-                    np.lib.format.write_array_header_2_0(member, {"descr": "<f8", "fortran_order": False, "shape": shape})
+                    np.lib.format.write_array_header_2_0(member, {"descr": "<f8", "fortran_order": False,
+                                                                  "shape": shape})
                     for chunk in chunks((name,)):
                         member.write(np.ascontiguousarray(chunk[name], dtype="<f8").tobytes())
             for name, values in self.names.items():

@@ -232,7 +232,10 @@ def soak(hours: float, stroke: str, out_dir: OutputFolder | Path, progress: bool
     write_json(out_dir / "config.json", resolved_config(episode, spec, "soak", hours=hours))
     every = int(round(SOAK_SAMPLE_S * episode.sim.config.physics_hz))
     samples = [(0.0, rss_mb())]
-    sample = (lambda sim: samples.append((sim.time_s, rss_mb())) if sim.steps % every == 0 else None)
+
+    def sample(sim) -> None:
+        if sim.steps % every == 0:
+            samples.append((sim.time_s, rss_mb()))
 
     def memory() -> dict:
         times, rss = np.array(samples).T
@@ -434,7 +437,8 @@ def bench_sph(seconds: float = 0.5, settings=None, stroke: str = "breaststroke")
     finally:
         episode.close()
     return {"stroke": stroke, "fluid_particles": report["fluid_particles"],
-            "boundary_particles": report["boundary_particles"], "particle_radius_m": fluid.sph_settings.particle_radius_m,
+            "boundary_particles": report["boundary_particles"],
+            "particle_radius_m": fluid.sph_settings.particle_radius_m,
             "threads": fluid.sph_settings.solver_threads, "steps": steps, "ms_per_step": 1e3 * wall / steps,
             "wall_s_per_simulated_s": wall / seconds, "solver_ms_per_step": 1e3 * solver / steps,
             "outside_solver_share": 1.0 - solver / wall, "settle_wall_s": report["settle_wall_s"],
@@ -443,9 +447,9 @@ def bench_sph(seconds: float = 0.5, settings=None, stroke: str = "breaststroke")
 
 def bench_step(seconds: float = 5.0, physics_hz: int | None = None, stroke: str | None = None) -> dict:
     """Microseconds per physics step: (a) the bare PyBullet step of the floating body (no fluid,
-    no PD), (b) the whole loop (state read, fluid, wrenches, PD, step) through the episode runner. Each is timed BENCH_REPEATS times, alternating so that a burst of
-    load elsewhere hits both, and the fastest repeat counts (the usual rule for timing: noise
-    never makes code faster)."""
+    no PD), (b) the whole loop (state read, fluid, wrenches, PD, step) through the episode runner.
+    Each is timed BENCH_REPEATS times, alternating so that a burst of load elsewhere hits both, and
+    the fastest repeat counts (the usual rule for timing: noise never makes code faster)."""
     check_seconds(seconds)
     if stroke is None:
         stroke = "front_crawl" if "front_crawl" in available_strokes() else "rest"

@@ -15,8 +15,8 @@ from typing import Annotated, Literal, Union
 from pydantic import Field
 
 from layered_swim.config import ConfigError, Strict, between, parse
+from layered_swim.control.cycle_choice import TempoControl
 from layered_swim.control.layered import Layers
-from layered_swim.control.policy import TempoControl
 from layered_swim.episode import START_JITTER, WIDE_JITTER, Episode
 from layered_swim.fluid.medium import Medium, water
 from layered_swim.recorder import DEFAULT_LOG_HZ
@@ -74,7 +74,7 @@ class SwimSpec(Strict):
     layers: str = Layers().describe()
     seed: int = Field(0, ge=0, le=2**31 - 1)    # 0: the task's exact start; others jitter it
     jitter: Literal["start", "wide"] = "start"  # how far a seed moves the start
-    policy: str | None = None                   # a learned residual (policy.pt) on its reference
+    policy: str | None = None                   # a learned residual's file (policy.pt) on its reference
 
     def model_post_init(self, _context) -> None:
         Layers.parse(self.layers)                # one line if malformed
@@ -99,7 +99,7 @@ class SwimSpec(Strict):
 
     def episode(self, wrap=None, layers: Layers | None = None) -> Episode:
         """The episode this spec describes (``wrap``/``layers``: a learned residual's controller
-        around its reference layers, see ``rl.policy.Policy.attach``)."""
+        around its reference layers, see ``rl.policy.ResidualPolicy.steering``)."""
         from layered_swim.tasks import FollowTarget, FreeSwim, GoalReaching
 
         task = self.task

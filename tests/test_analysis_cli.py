@@ -4,7 +4,6 @@ import csv
 import json
 
 import pytest
-
 from test_cli import assert_one_line_error, cli
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -14,7 +13,8 @@ ANALYSIS_FILES = {"summary.json", "config.json", "cycles.csv", "profiles.csv", "
 
 def test_tiny_analyze_writes_files_that_parse(tmp_path):
     out = tmp_path / "bs"
-    result = cli("analyze", "--stroke", "breaststroke", "--seconds", "4.5", "--settle", "1", "--out", str(out), "--json")
+    result = cli("analyze", "--stroke", "breaststroke", "--seconds", "4.5", "--settle", "1", "--out", str(out),
+                 "--json")
     assert result.returncode == 0, result.stderr
     printed = json.loads(result.stdout)
     assert {p.name for p in out.iterdir() if not p.name.startswith('.layered-swim')} == ANALYSIS_FILES

@@ -3,8 +3,8 @@ a swim: joint work = change of kinetic and potential energy - work of the water.
 import numpy as np
 import pytest
 
-from layered_swim.geometry import quat_rotate
 from layered_swim.episode import Episode
+from layered_swim.geometry import quat_rotate
 from layered_swim.recorder import Recorder
 
 SECONDS = 2.0

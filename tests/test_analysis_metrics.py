@@ -6,9 +6,19 @@ import numpy as np
 import pytest
 
 from layered_swim.analysis.reference_ranges import Range, active_drag_range, ranges_for
-from layered_swim.analysis.stroke_metrics import (SwimmerInfo, amplitude, analyze_log, heading_deg, mean_power_w,
-                                                  pitch_deg, propelling_efficiency, propulsive_resistive_n,
-                                                  reach_along_body_m, speed_fluctuation_pct, travel_direction)
+from layered_swim.analysis.stroke_metrics import (
+    SwimmerInfo,
+    amplitude,
+    analyze_log,
+    heading_deg,
+    mean_power_w,
+    pitch_deg,
+    propelling_efficiency,
+    propulsive_resistive_n,
+    reach_along_body_m,
+    speed_fluctuation_pct,
+    travel_direction,
+)
 from layered_swim.config import ConfigError
 from layered_swim.geometry import quat_multiply
 from layered_swim.sim.simulation import PRONE_QUAT_XYZW
@@ -141,7 +151,8 @@ def test_too_short_a_swim_is_an_error():
 
 def test_verdicts_against_the_data_sheet():
     r = Range(0.6, 1.0, "x")
-    assert [r.verdict(v) for v in (0.5, 0.6, 0.8, 1.0, 1.2, None)] == ["below", "inside", "inside", "inside", "above", "n/a"]
+    assert [r.verdict(v) for v in (0.5, 0.6, 0.8, 1.0, 1.2, None)] == ["below", "inside", "inside", "inside",
+                                                                       "above", "n/a"]
     drag = active_drag_range(1.0)
     assert (drag.low, drag.high) == (32.2, 38.0)
     assert "speed_fluctuation_pct" in ranges_for("breaststroke", 0.7) and ranges_for("made_up_stroke", 1.0) == {}

@@ -57,8 +57,8 @@ def test_a_run_does_not_depend_on_the_hash_seed(tmp_path):
     outputs = []
     for seed in ("0", "1"):
         env = {**os.environ, "PYTHONHASHSEED": seed, "PYTHONPATH": str(repo)}
-        run = subprocess.run([sys.executable, "-m", "layered_swim", "follow", "straight_line", "--seconds", "4", "--json",
-                              "--out", str(tmp_path / seed)],
+        run = subprocess.run([sys.executable, "-m", "layered_swim", "follow", "straight_line", "--seconds", "4",
+                              "--json", "--out", str(tmp_path / seed)],
                              cwd=repo, env=env, capture_output=True, text=True, timeout=120)
         assert run.returncode == 0, run.stderr
         outputs.append(json.loads(run.stdout)["mean_distance_m"])

@@ -7,13 +7,13 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from layered_swim.render import scene as sc
-from layered_swim.render.camera import OrbitCamera, look_at, perspective
-from layered_swim.render.frames import FrameWriter
-from layered_swim.render.hud import hud_lines
-from layered_swim.render.headless import frame_steps
-from layered_swim.render.session import MAX_LAG_S, SLOW_MOTION, SwimSession
 from layered_swim.config import ConfigError
+from layered_swim.render import scene as sc
+from layered_swim.render.camera import VIEWS, OrbitCamera, look_at, perspective
+from layered_swim.render.frames import FrameWriter
+from layered_swim.render.headless import steps_between
+from layered_swim.render.hud import hud_lines
+from layered_swim.render.session import MAX_LAG_S, SLOW_MOTION, SwimSession
 
 
 def test_look_at_puts_the_focus_straight_ahead():
@@ -46,6 +46,58 @@ def test_camera_orbit_stays_above_water_and_zoom_is_bounded():
     assert camera.distance_m == pytest.approx(60.0)
     camera.follow(np.array([10.0, 0.0, -1.0]), dt_s=100.0)
     assert camera.focus_m == pytest.approx([10.0, 0.0, 0.0])     # focus kept at the surface
+
+
+def test_views_put_the_eye_above_on_and_under_the_surface():
+    camera = OrbitCamera(focus_m=np.array([2.0, 1.0, 0.0]))
+    assert camera.eye_m[2] > 1.0
+    camera.set_view("side")
+    assert camera.eye_m[2] == pytest.approx(0.0)
+    camera.orbit(0, 500)
+    assert camera.eye_m[2] == pytest.approx(0.0)                  # level with the surface, however dragged
+    assert camera.next_view() == "underwater"
+    for drag in (-10_000, 10_000):
+        camera.orbit(0, drag)
+        assert camera.eye_m[2] < 0.0
+    camera.zoom(-100)
+    assert camera.distance_m == VIEWS["underwater"].max_distance_m
+    assert camera.next_view() == "follow" and camera.eye_m[2] > 0
+
+
+def test_side_and_underwater_views_turn_with_the_swimmer():
+    camera = OrbitCamera()
+    camera.set_view("side")
+    for k in range(1, 301):                                      # 5 s swimming along +y at 1 m/s
+        camera.follow(np.array([0.0, k / 60, -0.3]), 1 / 60)
+    assert math.degrees(camera.heading_rad) == pytest.approx(90.0, abs=1.0)
+    to_eye = camera.eye_m - camera.focus_m
+    assert to_eye[0] > 0.99 * camera.distance_m                  # square to its right: +x of a swimmer heading +y
+    held = camera.heading_rad
+    for _ in range(60):                                           # it stops: the view holds
+        camera.follow(np.array([0.0, 5.0, -0.3]), 1 / 60)
+    camera.follow(np.array([0.0, 5.0, -0.3]), 1 / 60)
+    assert camera.heading_rad == pytest.approx(held, abs=math.radians(3))
+
+
+def test_water_point_from_under_water():
+    camera = OrbitCamera(focus_m=np.array([1.0, 2.0, 0.0]))
+    camera.set_view("underwater")
+    point = np.array([1.5, 2.5, 0.0])
+    assert camera.water_point(*camera.project(point, 960, 540), 960, 540) == pytest.approx(point, abs=1e-6)
+    assert camera.water_point(480, 1, 960, 540) is None           # down into the deep: no surface there
+
+
+def test_flow_lattice_stays_put_and_lies_under_water():
+    a, b = sc.flow_lattice(np.array([0.2, 0.1, -0.3])), sc.flow_lattice(np.array([0.4, -0.3, -0.5]))
+    assert np.array_equal(a, b) and len(a) == (2 * sc.FLOW_HALF_POINTS + 1) ** 2 * len(sc.FLOW_DEPTHS_M)
+    assert (a[:, 2] < 0).all()
+    assert sc.cross_lines(a).shape == (4 * len(a), 3)
+
+
+def test_render_cameras_are_the_views():
+    from layered_swim.commands.render import CAMERAS
+
+    assert CAMERAS == tuple(VIEWS)
 
 
 def test_box_triangles_span_the_rotated_box():
@@ -82,9 +134,10 @@ def test_segment_colors_tell_cap_suit_and_sides_apart():
     assert colors[2, 0] < colors[3, 0]
 
 
-def test_frame_steps_add_up_exactly():
-    assert sum(frame_steps(k, 480, 30) for k in range(30)) == 480
-    assert sum(frame_steps(k, 480, 7) for k in range(7 * 5)) == 480 * 5
+def test_steps_between_frames_add_up_exactly():
+    assert sum(steps_between(k / 30, (k + 1) / 30, 480) for k in range(30)) == 480
+    assert sum(steps_between(k / 7, (k + 1) / 7, 480) for k in range(7 * 5)) == 480 * 5
+    assert steps_between(0.9, 0.95, 480) == 24                   # a still's last stretch, off the frame grid
 
 
 @pytest.fixture(scope="module")
@@ -190,10 +243,11 @@ def test_frame_writer_png_fallback(tmp_path):
 
 
 def test_a_shipped_policy_drives_the_session_and_the_hud_says_so():
-    from layered_swim.rl.policy import Policy
     from layered_swim.render.hud import hud_lines
+    from layered_swim.rl.policy import ResidualPolicy
 
-    policy = Policy.load(Path(__file__).resolve().parents[1] / "layered_swim/rl/policies/front_crawl_layered.pt")
+    shipped = Path(__file__).resolve().parents[1] / "layered_swim/rl/policies/front_crawl_layered.pt"
+    policy = ResidualPolicy.load(shipped)
     s = SwimSession("front_crawl", policy=policy)
     s.step(64)
     assert np.isfinite(s.com_m).all() and np.any(s.sim.controller.residual_rad != 0.0)

@@ -4,8 +4,7 @@ import pybullet
 import pytest
 
 from layered_swim.episode import Episode
-from layered_swim.sim.articulation import (ANGVEL, LINVEL, POS, QUAT, ROT, generalized_forces,
-                                           mass_matrix_and_bias)
+from layered_swim.sim.articulation import ANGVEL, LINVEL, POS, QUAT, ROT, generalized_forces, mass_matrix_and_bias
 
 GRAVITY_M_S2 = 9.81
 

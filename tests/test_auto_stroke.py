@@ -50,11 +50,11 @@ def test_auto_holds_a_still_target_by_treading_water_and_never_jumps_the_pose():
         controller, state = episode.controller, episode.sim.state
     finally:
         episode.close()
-    assert controller.switches and controller.switches[0][1] == HOLD and controller.active == HOLD
+    assert controller.switches and controller.switches[0].stroke == HOLD and controller.active == HOLD
     assert np.linalg.norm(state.com_m[:2] - [2.5, 0.0]) < 1.0
     steps = np.abs(np.diff(np.array(poses), axis=0)).max(axis=1)
     hz = episode.sim.config.physics_hz
-    switch = int(round(controller.switches[0][0] * hz))
+    switch = int(round(controller.switches[0].time_s * hz))
     # Across the switch the pose moves no faster than the strokes themselves move it.
     assert steps[switch - 5:switch + 5].max() <= 1.5 * np.percentile(steps, 99.9)
 
@@ -71,12 +71,13 @@ def test_auto_starts_holding_a_still_target_as_soon_as_it_is_in_reach():
     try:
         switched = []
         episode.run(8.0, observers=[lambda sim: switched or not episode.controller.switches or switched.append(
-            (sim.time_s, episode.controller.controllers[TURN].cycle_start_s, episode.controller.controllers[TURN].cycles_per_s,
+            (sim.time_s, episode.controller.controllers[TURN].cycle_start_s,
+             episode.controller.controllers[TURN].cycles_per_s,
              float(np.linalg.norm(sim.state.com_m - [2.5, 0.0, -0.3]))))])
         controller = episode.controller
     finally:
         episode.close()
-    assert controller.switches[0][1] == HOLD
+    assert controller.switches[0].stroke == HOLD
     time_s, cycle_start_s, cycles_per_s, distance_m = switched[0]
     assert (time_s - cycle_start_s) * cycles_per_s < 0.95      # mid-cycle
     assert distance_m < RULE.hold_within_m + 0.05
@@ -95,8 +96,8 @@ def test_auto_leaves_a_held_target_the_moment_it_jumps_away():
     finally:
         episode.close()
     held = [t for t, name in switches if name == HOLD]
-    assert held and held[0] < 9.0 and switches[-1][1] == TURN
-    left_s = switches[-1][0]
+    assert held and held[0] < 9.0 and switches[-1].stroke == TURN
+    left_s = switches[-1].time_s
     assert 9.0 <= left_s < 9.05
     _, _, cycle_start_s, cycles_per_s = next(row for row in seen if row[0] >= left_s - 1e-9)
     assert (left_s - cycle_start_s) * cycles_per_s < 0.95      # mid-cycle
@@ -110,10 +111,10 @@ def test_after_treading_water_the_breaststroke_levels_off_and_gets_away_sooner()
     left_m = {}
     for level_off in (True, False):
         episode = Episode("auto", FollowTarget(jump))
-        policy = episode.controller.controllers[TURN].policy
-        assert policy.level_off_beyond_rad is not None      # the shipped breaststroke has one
+        chooser = episode.controller.controllers[TURN].chooser
+        assert chooser.level_off_beyond_rad is not None      # the shipped breaststroke has one
         if not level_off:
-            policy.level_off_beyond_rad = None
+            chooser.level_off_beyond_rad = None
         try:
             episode.run(17.0)
             left_m[level_off] = float(np.linalg.norm(episode.sim.state.com_m - [10.5, 0.0, -0.3]))

@@ -38,7 +38,8 @@ def _swim(stroke: str, seconds: float):
         episode.run(2.0)
         start = episode.sim.state.com_m[0]
         episode.run(seconds - 2.0, observers=[observe])
-        return (episode.sim.state.com_m[0] - start) / (seconds - 2.0), float(np.mean(fronts)), float(np.max(np.abs(headings)))
+        return ((episode.sim.state.com_m[0] - start) / (seconds - 2.0), float(np.mean(fronts)),
+                float(np.max(np.abs(headings))))
     finally:
         episode.close()
 

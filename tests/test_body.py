@@ -1,14 +1,13 @@
 """The body file: the Yang swimmer's numbers, its URDF in PyBullet, and errors for bad files."""
-import numpy as np
 import pybullet
 import pytest
 import yaml
 from pybullet_utils.bullet_client import BulletClient
 
+from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import DEFAULT_BODY_FILE, load_body
 from layered_swim.body.urdf import axis_joint_name, write_urdf
 from layered_swim.config import ConfigError
-from layered_swim.body.layout import joint_layout
 
 ROOT_DOF = 6
 

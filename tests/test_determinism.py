@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 
 from layered_swim.control.stroke import available_strokes
+from layered_swim.recorder import log_hash
 from layered_swim.runs import run_swim
 from layered_swim.spec import SwimSpec
-from layered_swim.recorder import log_hash
 
 SECONDS = 1.5
 

@@ -268,7 +268,8 @@ def test_documented_command_parses(command):
 def test_yaml_example_loads(where, data):
     from layered_swim.body.layout import joint_layout
     from layered_swim.body.model import load_body
-    from layered_swim.config import ConfigError, parse as parse_model
+    from layered_swim.config import ConfigError
+    from layered_swim.config import parse as parse_model
     from layered_swim.control.stroke import StrokeSpec, build_stroke
     from layered_swim.control.targets import build_trajectory, parse_trajectory
 
@@ -419,7 +420,8 @@ def test_follow_the_readme_example_then_render_it(tmp_path):
     files = {p.name for p in out.iterdir()}
     assert {"summary.json", "config.json", "log.npz", "timeseries.csv", "track.npz"} <= files
     summary = json.loads((out / "summary.json").read_text())
-    described = backticked(section(FORMATS, "### summary.json")) | backticked(section(REPO / "docs" / "cli.md", "## follow"))
+    described = (backticked(section(FORMATS, "### summary.json"))
+                 | backticked(section(REPO / "docs" / "cli.md", "## follow")))
     assert set(summary) <= described
     config = json.loads((out / "config.json").read_text())
     assert set(config) <= backticked(section(FORMATS, "### config.json"))

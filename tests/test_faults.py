@@ -10,13 +10,13 @@ from importlib.util import find_spec
 from pathlib import Path
 
 import pytest
+from test_cli import REPO
 
 from layered_swim import outputs, recorder
 from layered_swim.cli import report_errors
 from layered_swim.recorder import SPOOL_DIR, read_log
 from layered_swim.runs import run_swim
 from layered_swim.spec import SwimSpec
-from test_cli import REPO
 
 CHUNK_ROWS = 6      # a 0.5 s run at 60 Hz: five chunks in the spool, not one per 10 s
 

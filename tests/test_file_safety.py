@@ -9,10 +9,10 @@ import time
 
 import numpy as np
 import pytest
+from test_cli import REPO, assert_one_line_error, cli
 
 from layered_swim.config import ConfigError, read_text
 from layered_swim.outputs import LOCK, MARKER, PREVIOUS, check_out_dir, claim, prepare_out_dir, release
-from test_cli import REPO, assert_one_line_error, cli
 
 
 def _tree(folder):
@@ -23,7 +23,8 @@ def test_a_rejected_command_leaves_the_folder_as_it_was(tmp_path):
     victim = tmp_path / "v"
     victim.mkdir()
     (victim / "keep").write_text("x")
-    assert_one_line_error(cli("run", "--stroke", "nosuch", "--out", str(victim), "--overwrite"), "not a layered-swim output")
+    assert_one_line_error(cli("run", "--stroke", "nosuch", "--out", str(victim), "--overwrite"),
+                          "not a layered-swim output")
     assert (victim / "keep").read_text() == "x" and _tree(victim) == ["keep"]
     mine = tmp_path / "mine"       # our own output, but the arguments are wrong: nothing moves either
     assert cli("run", "--stroke", "rest", "--seconds", "0.2", "--out", str(mine)).returncode == 0

@@ -7,15 +7,14 @@ import sys
 
 import numpy as np
 import pytest
+from test_layered_control import still_state, table
 
 from layered_swim.analysis.robustness import spread
-from layered_swim.control.policy import TargetPolicy
+from layered_swim.control.cycle_choice import TargetChooser
 from layered_swim.control.targets import StationTarget
 from layered_swim.episode import START_JITTER, WIDE_JITTER, jittered_start
 from layered_swim.state import Start
 from layered_swim.tasks.follow import hold_depth, station_metrics
-
-from test_layered_control import still_state, table
 
 
 def test_depth_is_checked_only_while_the_target_holds_one():
@@ -62,7 +61,7 @@ def test_a_jumping_target_is_not_anticipated():
     """One second before the target jumps behind, the swimmer still heads for where it is."""
     target = StationTarget(np.array([[5.0, 0.0, 0.0], [-5.0, 0.0, 0.0]]), np.array([0.0, 1.0]))
     state = still_state(np.full(16, 1 / 16))
-    assert TargetPolicy(target, table(), "prone")(0, state, 0.0).thrust_demand == pytest.approx(1.0)
+    assert TargetChooser(target, table(), "prone")(0, state, 0.0).thrust_demand == pytest.approx(1.0)
 
 
 def test_medians_count_a_run_that_never_got_there_as_worst():
@@ -83,6 +82,6 @@ def test_follow_seeds_reports_medians_over_perturbed_starts(tmp_path):
     assert summary["median"]["mean_distance_m"]["median"] == pytest.approx(np.median(distances))
     assert summary["reached_all_share"] == 0.0                # 4 m away, one second
     assert json.loads((out / "summary.json").read_text())["runs"] == summary["runs"]
-    refused = subprocess.run([sys.executable, "-m", "layered_swim", "follow", "jumping", "--seconds", "1", "--seeds", "2",
-                              "--backend", "sph"], capture_output=True, text=True, timeout=300)
+    refused = subprocess.run([sys.executable, "-m", "layered_swim", "follow", "jumping", "--seconds", "1",
+                              "--seeds", "2", "--backend", "sph"], capture_output=True, text=True, timeout=300)
     assert refused.returncode == 2 and refused.stderr.count("\n") == 1 and "--seeds" in refused.stderr

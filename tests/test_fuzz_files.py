@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import DEFAULT_BODY_FILE, load_body

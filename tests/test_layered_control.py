@@ -4,18 +4,26 @@ import math
 import numpy as np
 import pytest
 
+from layered_swim.analysis.calibrate import _measure, weight_grid
+from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, load
-from layered_swim.analysis.calibrate import _measure, weight_grid
 from layered_swim.control.calibration import CalibrationTable, Pace, load_table
-from layered_swim.control.layered import CycleChoice, Layers, LayeredController, fixed_weights
-from layered_swim.body.layout import joint_layout
-from layered_swim.geometry import quat_multiply
+from layered_swim.control.cycle_choice import Lead, TargetChooser, TempoControl
+from layered_swim.control.layered import CycleChoice, LayeredController, Layers, fixed_weights
 from layered_swim.control.rules import arm_indices, rule_offsets
 from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, wanted_turns
-from layered_swim.control.stroke import (LEVEL_OFF, JointKeys, PerturbationSpec, RulesSpec, StrokeSpec, build_stroke,
-                                         load_stroke, mirrored_keys, stroke_path)
-from layered_swim.control.policy import Lead, TargetPolicy, TempoControl
+from layered_swim.control.stroke import (
+    LEVEL_OFF,
+    JointKeys,
+    PerturbationSpec,
+    RulesSpec,
+    StrokeSpec,
+    build_stroke,
+    load_stroke,
+    mirrored_keys,
+    stroke_path,
+)
 from layered_swim.control.targets import FixedTarget, TrajectoryTarget, load_trajectory
 from layered_swim.episode import Episode
 from layered_swim.sim.simulation import PRONE_QUAT_XYZW
@@ -110,7 +118,8 @@ def test_glide_holds_the_pose_but_the_joints_that_keep_moving():
 
     def glide(cycle, state, mean_roll_rad):
         return CycleChoice(glide=True)
-    controller = LayeredController(stroke, LAYOUT, arm_indices(BODY, LAYOUT), glide, Layers(cycle=True, palm=False, reach=False))
+    controller = LayeredController(stroke, LAYOUT, arm_indices(BODY, LAYOUT), glide,
+                                   Layers(cycle=True, palm=False, reach=False))
     state = still_state()
     pose, rate = controller.desired(0.0, state, np.zeros((16, 3)))
     state.time_s = 0.3 * stroke.period_s
@@ -128,13 +137,13 @@ def test_steering_settings_come_from_the_stroke_file_and_leave_its_calibration_f
     crawl = Episode("front_crawl", FollowTarget(FixedTarget([5.0, 0.0, -0.3])))
     crawl.close()
     steering = crawl.stroke.steering
-    gains = crawl.controller.policy.gains
+    gains = crawl.controller.chooser.gains
     assert (gains.yaw_fraction, gains.pitch_fraction, gains.roll_fraction) == (
         steering.yaw_fraction, steering.pitch_fraction, steering.roll_fraction)
-    assert crawl.controller.policy.tempo_control.min_tempo == steering.min_tempo
+    assert crawl.controller.chooser.tempo_control.min_tempo == steering.min_tempo
     breast = Episode("breaststroke", FollowTarget(FixedTarget([5.0, 0.0, -0.3])))
     breast.close()
-    assert breast.controller.policy.tempo_control.wide_turn_rad == pytest.approx(math.radians(180.0))
+    assert breast.controller.chooser.tempo_control.wide_turn_rad == pytest.approx(math.radians(180.0))
     assert breast.controller.lungs is not None and crawl.controller.lungs is None
     spec = load(StrokeSpec, stroke_path("front_crawl"))
     edited = spec.model_copy(update={"steering": spec.steering.model_copy(update={"yaw_fraction": 0.1})})
@@ -163,7 +172,8 @@ def test_palm_rule_faces_a_helpful_flow_and_slices_a_hindering_one(hand_velocity
     helpful = rule_offsets(none, arms, RulesSpec(), quat, velocity, np.zeros((16, 3)), np.array([1.0, 0.0, 0.0]), 0.01)
     assert _facing_change(arm, helpful, quat, flow_dir) > 0          # palm turns into the flow
     assert helpful[arm.elbow_coord] < 0                              # and the arm reaches further
-    hindering = rule_offsets(none, arms, RulesSpec(), quat, velocity, np.zeros((16, 3)), np.array([-1.0, 0.0, 0.0]), 0.01)
+    hindering = rule_offsets(none, arms, RulesSpec(), quat, velocity, np.zeros((16, 3)), np.array([-1.0, 0.0, 0.0]),
+                             0.01)
     assert _facing_change(arm, hindering, quat, flow_dir) < 0        # palm slices
     assert hindering[arm.elbow_coord] > 0                            # and the arm stays closer
 
@@ -175,7 +185,8 @@ def test_rule_offsets_fade_and_stay_within_their_limits():
     velocity[arms[0].hand] = [-1.0, -0.5, 0.3]
     offsets = np.zeros(LAYOUT.size)
     for _ in range(2000):                        # a long push saturates at max_deg
-        offsets = rule_offsets(offsets, arms, RulesSpec(), quat, velocity, np.zeros((16, 3)), np.array([1.0, 0, 0]), 0.01)
+        offsets = rule_offsets(offsets, arms, RulesSpec(), quat, velocity, np.zeros((16, 3)), np.array([1.0, 0, 0]),
+                               0.01)
     assert np.abs(np.degrees(offsets)).max() == pytest.approx(RulesSpec().palm.max_deg)
     still = np.zeros((16, 3))                    # no flow past the hands: the offsets fade away
     for _ in range(200):
@@ -343,12 +354,13 @@ def test_lead_aims_from_the_swimmers_own_place_on_the_path_when_it_is_ahead():
 def test_a_swimmer_ahead_of_its_target_waits_for_it():
     state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
     behind = TrajectoryTarget(np.array([[-2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 22.0]), 0.5, False)
-    waiting = TargetPolicy(behind, table(), "prone")(0, state, 0.0)
-    assert not waiting.glide and waiting.thrust_demand == 0.0 and waiting.tempo == pytest.approx(TempoControl().min_tempo)
-    gliding = TargetPolicy(behind, table(), "prone", tempo=TempoControl(glide_within_m=0.6))(0, state, 0.0)
+    waiting = TargetChooser(behind, table(), "prone")(0, state, 0.0)
+    assert (not waiting.glide and waiting.thrust_demand == 0.0
+            and waiting.tempo == pytest.approx(TempoControl().min_tempo))
+    gliding = TargetChooser(behind, table(), "prone", tempo=TempoControl(glide_within_m=0.6))(0, state, 0.0)
     assert gliding.glide       # a stroke that glides to wait (the crawl) glides
     ahead = TrajectoryTarget(np.array([[2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 18.0]), 0.5, False)
-    chasing = TargetPolicy(ahead, table(), "prone")(0, state, 0.0)
+    chasing = TargetChooser(ahead, table(), "prone")(0, state, 0.0)
     assert not chasing.glide and chasing.thrust_demand == pytest.approx(1.0)
 
 
@@ -359,11 +371,11 @@ def test_a_gliding_stroke_near_its_target_glides_only_once_ahead_of_it_along_its
     state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
     tempo = TempoControl(glide_within_m=0.4)
     leading = TrajectoryTarget(np.array([[0.3, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 39.4]), 0.5, False)
-    assert not TargetPolicy(leading, table(), "prone", tempo=tempo)(0, state, 0.0).glide
+    assert not TargetChooser(leading, table(), "prone", tempo=tempo)(0, state, 0.0).glide
     trailing = TrajectoryTarget(np.array([[-0.3, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 40.6]), 0.5, False)
-    policy = TargetPolicy(trailing, table(), "prone", tempo=tempo, lead=Lead(wait_ahead_s=10.0))   # near, not waiting
-    assert policy(0, state, 0.0).glide
-    assert TargetPolicy(FixedTarget((0.3, 0.0, 0.0)), table(), "prone", tempo=tempo)(0, state, 0.0).glide
+    chooser = TargetChooser(trailing, table(), "prone", tempo=tempo, lead=Lead(wait_ahead_s=10.0))   # near, not waiting
+    assert chooser(0, state, 0.0).glide
+    assert TargetChooser(FixedTarget((0.3, 0.0, 0.0)), table(), "prone", tempo=tempo)(0, state, 0.0).glide
 
 
 def test_weights_above_one_only_for_a_turn_wanted_within_the_strokes_limit():
@@ -373,7 +385,7 @@ def test_weights_above_one_only_for_a_turn_wanted_within_the_strokes_limit():
 
     def yaw_left_weight(bearing_deg):
         target = FixedTarget((5 * math.cos(math.radians(bearing_deg)), 5 * math.sin(math.radians(bearing_deg)), 0.0))
-        return TargetPolicy(target, to_1_5, "prone", gains=gains)(0, state, 0.0).weights["yaw_left"]
+        return TargetChooser(target, to_1_5, "prone", gains=gains)(0, state, 0.0).weights["yaw_left"]
     assert yaw_left_weight(50.0) == 1.5 and yaw_left_weight(100.0) == 1.0
 
 
@@ -382,10 +394,10 @@ def test_a_swimmer_keeps_a_moving_targets_pace_when_close_behind_it():
     speed is 0.6 m/s (0.75 in this table: 0.4 m/s at 0.5, 0.8 m/s at 1.0), not at its slowest."""
     state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
     moving = TrajectoryTarget(np.array([[0.1, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 19.9]), 0.6, False)
-    assert TargetPolicy(moving, table(), "prone")(0, state, 0.0).tempo == pytest.approx(0.75)
-    unkept = TargetPolicy(moving, table(), "prone", tempo=TempoControl(keep_pace=False))(0, state, 0.0)
+    assert TargetChooser(moving, table(), "prone")(0, state, 0.0).tempo == pytest.approx(0.75)
+    unkept = TargetChooser(moving, table(), "prone", tempo=TempoControl(keep_pace=False))(0, state, 0.0)
     assert unkept.tempo == pytest.approx(TempoControl().min_tempo)
-    still = TargetPolicy(FixedTarget((0.1, 0.0, 0.0)), table(), "prone")(0, state, 0.0)
+    still = TargetChooser(FixedTarget((0.1, 0.0, 0.0)), table(), "prone")(0, state, 0.0)
     assert still.tempo == pytest.approx(TempoControl().min_tempo)   # a target that stays: no pace to keep
 
 
@@ -410,17 +422,17 @@ def test_a_swimmer_starting_pitched_up_levels_off_instead_of_correcting_pitch():
     pitch_table = table()
     pitch_table.turn_rad["pitch_down"] = pitch_table.turn_rad["yaw_left"]
     target = FixedTarget((5.0, 1.0, 0.0))
-    policy = TargetPolicy(target, pitch_table, "prone", level_off_beyond_rad=math.radians(35.0))
-    assert "pitch_down" in TargetPolicy(target, pitch_table, "prone")(0, standing, 0.0).weights
-    up = policy(0, standing, 0.0).weights
+    chooser = TargetChooser(target, pitch_table, "prone", level_off_beyond_rad=math.radians(35.0))
+    assert "pitch_down" in TargetChooser(target, pitch_table, "prone")(0, standing, 0.0).weights
+    up = chooser(0, standing, 0.0).weights
     assert up[LEVEL_OFF] == 1.0 and not any(name.startswith("pitch_") for name in up) and up["yaw_left"] > 0
-    assert LEVEL_OFF in policy(1, standing, 0.0).weights          # still standing: still levelling
-    assert LEVEL_OFF not in policy(2, lying_state, 0.0).weights   # lying: done...
-    assert LEVEL_OFF not in policy(3, standing, 0.0).weights      # ...and a later pitch-up is not a start
-    assert LEVEL_OFF not in policy(0, lying_state, 0.0).weights
+    assert LEVEL_OFF in chooser(1, standing, 0.0).weights          # still standing: still levelling
+    assert LEVEL_OFF not in chooser(2, lying_state, 0.0).weights   # lying: done...
+    assert LEVEL_OFF not in chooser(3, standing, 0.0).weights      # ...and a later pitch-up is not a start
+    assert LEVEL_OFF not in chooser(0, lying_state, 0.0).weights
     # Levelling off, it kicks at its level-off tempo even for a target behind (which would slow it).
-    behind = TargetPolicy(FixedTarget((-5.0, 1.0, 0.0)), pitch_table, "prone", level_off_beyond_rad=math.radians(35.0),
-                          level_off_tempo=1.2)
+    behind = TargetChooser(FixedTarget((-5.0, 1.0, 0.0)), pitch_table, "prone", level_off_beyond_rad=math.radians(35.0),
+                           level_off_tempo=1.2)
     assert behind(0, standing, 0.0).tempo == 1.2
     assert behind(1, lying_state, 0.0).tempo == pytest.approx(TempoControl().min_tempo)
 
@@ -435,9 +447,9 @@ def test_a_level_off_sequence_leaves_the_calibration_valid():
     assert LEVEL_OFF in build_stroke(edited, LAYOUT, "x").perturbations
 
 
-def test_policy_asks_for_thrust_only_when_far_and_ahead():
+def test_target_chooser_asks_for_thrust_only_when_far_and_ahead():
     state = still_state(np.full(16, 1 / 16))
-    choice = lambda point: TargetPolicy(FixedTarget(point), table(), "prone")(0, state, 0.0)  # noqa: E731
+    choice = lambda point: TargetChooser(FixedTarget(point), table(), "prone")(0, state, 0.0)  # noqa: E731
     assert choice((5.0, 0.0, 0.0)).thrust_demand == pytest.approx(1.0)     # far, straight ahead
     assert choice((0.1, 0.0, 0.0)).thrust_demand == pytest.approx(0.0)     # there already
     assert choice((-5.0, 0.0, 0.0)).thrust_demand == pytest.approx(0.0)    # behind: turn first

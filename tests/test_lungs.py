@@ -30,7 +30,8 @@ def test_a_breath_changes_the_lung_segments_volume_and_so_the_buoyancy():
     delta = body.volume_m3 - out.volume_m3
     assert delta[thorax] == pytest.approx(3e-3) and np.count_nonzero(delta) == 1
     assert 4 / 3 * np.pi * np.prod(out.semi_axes_m[thorax]) == pytest.approx(out.volume_m3[thorax])
-    assert out.lung_air_l == 0.0 and body.lung_air_l == 3.0 and body.breathing(3.0).volume_m3 == pytest.approx(body.volume_m3)
+    assert (out.lung_air_l == 0.0 and body.lung_air_l == 3.0
+            and body.breathing(3.0).volume_m3 == pytest.approx(body.volume_m3))
     # Held 2 m under, the plates' buoyancy drops by rho g 3 L (29.3 N in fresh water).
     rest = Episode("rest")
     state = rest.sim.state
@@ -49,7 +50,8 @@ def test_a_breaststroke_breathes_out_to_follow_a_target_down_and_in_to_stop_ther
     episode = Episode("breaststroke", FollowTarget(FixedTarget([30.0, 0.0, -2.0])))
     air, depth = [], []
     try:
-        episode.run(12.0, observers=[lambda sim: (air.append(sim.lung_air_l), depth.append(-sim.state.pos("pelvis")[2]))])
+        episode.run(12.0, observers=[lambda sim: (air.append(sim.lung_air_l),
+                                                  depth.append(-sim.state.pos("pelvis")[2]))])
         assert min(air) == 0.0 and max(air) > 4.0          # out to sink, in to stop sinking
         assert max(depth) > 1.8 and abs(depth[-1] - 2.0) < 0.5
         assert episode.sim.fluid.body.lung_air_l == air[-1] == episode.controller.lung_air_l

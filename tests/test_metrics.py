@@ -3,9 +3,9 @@ import math
 import numpy as np
 import pytest
 
-from layered_swim.tasks.metrics import head_top_height_m, roll_deg, summary
 from layered_swim.geometry import quat_multiply
 from layered_swim.sim.simulation import PRONE_QUAT_XYZW
+from layered_swim.tasks.metrics import head_top_height_m, roll_deg, summary
 
 LOG_HZ = 60
 

@@ -4,11 +4,11 @@ import numpy as np
 import pybullet
 import pytest
 
-from layered_swim.body.model import load_body
-from layered_swim.sim.pd import _ball_error
 from layered_swim.body.layout import joint_layout
-from layered_swim.geometry import quat_multiply
+from layered_swim.body.model import load_body
 from layered_swim.episode import Episode
+from layered_swim.geometry import quat_multiply
+from layered_swim.sim.pd import _ball_error
 from layered_swim.sim.simulation import UPRIGHT_QUAT_XYZW
 from layered_swim.sim.world import World
 

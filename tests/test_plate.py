@@ -3,8 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from layered_swim.fluid.coefficients import (build_coefficient_table, plate_coefficients,
-                                             smoothed_knots)
+from layered_swim.fluid.coefficients import build_coefficient_table, plate_coefficients, smoothed_knots
 from layered_swim.fluid.plate import plate_wrenches, rectangle_submerged_fraction
 
 RHO = 1000.0

@@ -10,8 +10,9 @@ import pytest
 import layered_swim.rl  # noqa: F401  (registers the ids)
 from layered_swim.config import ConfigError
 from layered_swim.rl import observation as obs
+from layered_swim.rl.config import RewardSpec
 from layered_swim.rl.env import SwimGoalEnv
-from layered_swim.rl.reward import RewardWeights, deviation_m, forward_distance_m, reward_parts, yaw_error_rad
+from layered_swim.rl.reward import deviation_m, forward_distance_m, reward_parts, yaw_error_rad
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +45,7 @@ def test_stable_baselines3_ppo_trains_on_it_unmodified():
 
 
 def test_reward_parts_against_hand_computed_values():
-    w = RewardWeights()
+    w = RewardSpec()
     # On schedule at (1, 0); root at (0.8, 0.1); line along +x from the origin.
     assert forward_distance_m([1.0, 0.0, 0.0], [0.8, 0.1, -0.2], [1.0, 0.0, 0.0]) == pytest.approx(0.2)
     assert deviation_m([0.5, -0.3, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]) == pytest.approx(0.3)
@@ -66,7 +67,7 @@ def test_reward_parts_against_hand_computed_values():
 
 def test_bad_reward_weights_and_settings_are_one_line():
     with pytest.raises(ConfigError, match="forward_per_m"):
-        RewardWeights(forward_per_m=float("nan"))
+        SwimGoalEnv(reward_weights={"forward_per_m": float("nan")})
     with pytest.raises(ConfigError, match="env_state"):
         obs.layout_for(10, 10, 16, "Nothing")
     with pytest.raises(ConfigError, match="reference"):

@@ -14,10 +14,10 @@ import torch
 
 from layered_swim.config import ConfigError
 from layered_swim.rl.buffer import EpisodeData
-from layered_swim.rl.config import load_train_spec
-from layered_swim.rl.policy import MAX_POLICY_BYTES, Policy
-from layered_swim.rl.ppo import ActorCritic, Normaliser, update
 from layered_swim.rl.checkpoint import CHECKPOINT_FORMAT
+from layered_swim.rl.config import load_train_spec
+from layered_swim.rl.policy import MAX_POLICY_BYTES, ResidualPolicy
+from layered_swim.rl.ppo import ActorCritic, Normaliser, update
 from layered_swim.rl.train import CHECKPOINT, Trainer
 
 REPO = Path(__file__).resolve().parents[1]
@@ -67,7 +67,7 @@ def _trained_a_little(trainer: Trainer) -> Trainer:
     episodes = [_episode(trainer.rng, n_obs, n_act, steps, 0) for steps in (5, 9, 1)]
     trainer.normaliser.update(np.concatenate([e.obs for e in episodes]))
     trainer.buffer.add(episodes, 0, trainer.rng)
-    update(trainer.model, trainer.optimiser, trainer.buffer.episodes, trainer.normaliser, trainer.ppo,
+    update(trainer.model, trainer.optimiser, trainer.buffer.episodes, trainer.normaliser, trainer.spec.ppo,
            trainer.generator)
     trainer.epoch, trainer.samples, trainer.wall_s = 1, 15, 0.5
     return trainer
@@ -109,7 +109,7 @@ def test_a_checkpoint_round_trip_gives_the_same_state_and_the_same_next_update(t
         assert (mine.truncated, mine.epoch) == (theirs.truncated, theirs.epoch)
     assert np.array_equal(original.normaliser.mean, resumed.normaliser.mean)
     assert original.rng.bit_generator.state == resumed.rng.bit_generator.state
-    steps = [update(t.model, t.optimiser, t.buffer.episodes, t.normaliser, t.ppo, t.generator)
+    steps = [update(t.model, t.optimiser, t.buffer.episodes, t.normaliser, t.spec.ppo, t.generator)
              for t in (original, resumed)]
     assert steps[0] == steps[1]
     for a, b in zip(original.model.parameters(), resumed.model.parameters()):
@@ -152,6 +152,7 @@ def test_a_checkpoint_without_model_is_one_line(trainer, tmp_path):
 
 BAD_CHECKPOINTS = {
     "an older format": (("format",), 1, "older version; start over with --overwrite"),
+    "format 2 (buffer.policy, now buffer.eviction)": (("format",), 2, "older version; start over with --overwrite"),
     "NaN weights": (("model", "actor.0.weight"), torch.full((16, 255), float("nan")), "NaN"),
     "a weight of another shape": (("model", "actor.0.bias"), torch.zeros(17), "shape"),
     "integer weights": (("model", "actor.0.bias"), torch.zeros(16, dtype=torch.int64), "float tensor"),
@@ -228,7 +229,7 @@ BAD_POLICIES = {
 
 
 def test_the_shipped_policy_loads_and_checks_its_stroke():
-    policy = Policy.load(SHIPPED_POLICY)
+    policy = ResidualPolicy.load(SHIPPED_POLICY)
     policy.check_stroke(None)
     policy.check_stroke("front_crawl")
     with pytest.raises(ConfigError, match="trained for front_crawl, not breaststroke; add --stroke front_crawl"):
@@ -242,7 +243,7 @@ def test_a_bad_policy_file_is_one_line(shipped, tmp_path, name):
     where, value, words = BAD_POLICIES[name]
     path = _policy_file(tmp_path / "p.pt", _mutated(shipped, where, value))
     with pytest.raises(ConfigError) as err:
-        Policy.load(path)
+        ResidualPolicy.load(path)
     assert words in str(err.value) and str(err.value).startswith(f"{path}: ") and "\n" not in str(err.value)
 
 
@@ -268,16 +269,18 @@ def test_an_oversized_policy_file_is_refused_unread(tmp_path):
     with open(path, "wb") as f:
         f.truncate(MAX_POLICY_BYTES + 1)      # sparse: no disk used
     with pytest.raises(ConfigError, match="more than"):
-        Policy.load(path)
+        ResidualPolicy.load(path)
 
 
 def test_a_policy_written_by_the_trainer_loads(tmp_path):
     model, normaliser = ActorCritic(7, 2, (4,)), Normaliser(7)
-    env = load_train_spec(None).env.model_dump()
-    reward = load_train_spec(None).reward.model_dump()
-    path = _policy_file(tmp_path / "p.pt", Policy(model, normaliser, env, reward, (7, 2, (4,), -1.0)).to_file())
-    loaded = Policy.load(path)
-    assert loaded.model_args == (7, 2, (4,), -1.0) and loaded.env == env and loaded.source == str(path)
+    env, reward = load_train_spec(None).env, load_train_spec(None).reward
+    written = ResidualPolicy(model, normaliser, env, reward, (7, 2, (4,), -1.0)).to_file()
+    assert written["env"] == env.model_dump() and written["reward"] == reward.model_dump()   # plain dicts in the file
+    path = _policy_file(tmp_path / "p.pt", written)
+    loaded = ResidualPolicy.load(path)
+    assert loaded.model_args == (7, 2, (4,), -1.0) and loaded.model_args.n_obs == 7 and loaded.source == str(path)
+    assert loaded.env == env and loaded.reward == reward and loaded.env.stroke == env.stroke
     assert all(torch.equal(a, b) for a, b in zip(model.parameters(), loaded.model.parameters()))
 
 
@@ -303,3 +306,10 @@ def test_every_training_knob_has_bounds(setting):
 def test_eviction_needs_some_weight():
     with pytest.raises(ConfigError, match="w_age and w_reward"):
         load_train_spec(None, ["buffer.w_age=0", "buffer.w_reward=0"])
+
+
+def test_the_old_buffer_policy_key_says_its_new_name():
+    with pytest.raises(ConfigError, match="field 'buffer'.*policy is now called eviction") as err:
+        load_train_spec(None, ["buffer.policy=fifo"])
+    assert "\n" not in str(err.value)
+    assert load_train_spec(None, ["buffer.eviction=fifo"]).buffer.eviction == "fifo"

@@ -11,9 +11,9 @@ import pytest
 import torch
 
 from layered_swim.config import ConfigError
-from layered_swim.rl.buffer import EpisodeBuffer, EpisodeData, EvictionSettings, eviction_probabilities, transition
-from layered_swim.rl.config import load_train_spec
-from layered_swim.rl.policy import Policy
+from layered_swim.rl.buffer import EpisodeBuffer, EpisodeData, eviction_probabilities, transition
+from layered_swim.rl.config import BufferSpec, load_train_spec
+from layered_swim.rl.policy import ResidualPolicy
 from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, Normaliser, gae
 from layered_swim.rl.train import Trainer, train
 
@@ -22,7 +22,7 @@ TINY = ["run.episodes_per_epoch=2", "run.samples=150", "run.workers=1", "run.eva
 
 
 def test_progevict_probabilities_follow_the_equations():
-    s = EvictionSettings(e_mid=0.0, k=1.0, w_age=0.5, w_reward=0.5, sigma=0.5)
+    s = BufferSpec(e_mid=0.0, k=1.0, w_age=0.5, w_reward=0.5, sigma=0.5)
     p = eviction_probabilities([0, 0, 1, 2], [5.0, 1.0, 3.0, 2.0], current_epoch=2, s=s)
     t = 1 / (1 + math.exp(2.0))                                   # eq. 17 at e = 2
     age = np.array([9.0, 9.0, 4.0, 1.0]) / 23.0                   # eq. 19: (2 - e_i + 1)^2
@@ -41,14 +41,15 @@ def _episode(ret: float) -> EpisodeData:
 
 
 def test_fifo_evicts_the_oldest_and_late_progevict_keeps_the_best_and_the_worst():
-    fifo = EpisodeBuffer(3, "fifo")
+    fifo = EpisodeBuffer(BufferSpec(eviction="fifo", capacity_episodes=3))
     rng = np.random.default_rng(0)
     fifo.add([_episode(r) for r in (1.0, 2.0)], 0, rng)
     assert fifo.add([_episode(r) for r in (3.0, 4.0)], 1, rng) == 1
     assert [e.episode_return for e in fifo.episodes] == [2.0, 3.0, 4.0]
     kept = {r: 0 for r in range(9)}
     for seed in range(200):
-        late = EpisodeBuffer(8, "progevict", EvictionSettings(e_mid=0.0, k=1.0, w_age=0.0, w_reward=1.0))
+        late = EpisodeBuffer(BufferSpec(eviction="progevict", capacity_episodes=8, e_mid=0.0, k=1.0, w_age=0.0,
+                                        w_reward=1.0))
         late.add([_episode(float(r)) for r in range(9)], 100, np.random.default_rng(seed))
         for e in late.episodes:
             kept[int(e.episode_return)] += 1
@@ -106,9 +107,9 @@ def test_checkpoint_policy_and_resume(tmp_path):
     # The policy file gives the trainer's actions and normaliser back.
     trainer = Trainer(spec, tmp_path / "a")
     trainer.resume()
-    policy = Policy.load(tmp_path / "a" / "policy.pt")
+    policy = ResidualPolicy.load(tmp_path / "a" / "policy.pt")
     assert policy.normaliser.mean == pytest.approx(trainer.normaliser.mean)
-    obs = np.random.default_rng(2).normal(size=(5, trainer.model_args[0])).astype(np.float32)
+    obs = np.random.default_rng(2).normal(size=(5, trainer.model_args.n_obs)).astype(np.float32)
     mine, loaded = ActorSnapshot(trainer.model), ActorSnapshot(policy.model)
     for o in obs:
         assert np.array_equal(mine.act(trainer.normaliser(o), True)[0], loaded.act(policy.normaliser(o), True)[0])
@@ -127,9 +128,9 @@ def test_checkpoint_policy_and_resume(tmp_path):
 def test_a_damaged_policy_file_is_one_line(tmp_path):
     (tmp_path / "p.pt").write_bytes(b"not a policy")
     with pytest.raises(ConfigError, match="not a layered-swim policy file"):
-        Policy.load(tmp_path / "p.pt")
+        ResidualPolicy.load(tmp_path / "p.pt")
     with pytest.raises(ConfigError, match="no such policy file"):
-        Policy.load(tmp_path / "none.pt")
+        ResidualPolicy.load(tmp_path / "none.pt")
 
 
 def _cli(*args):
@@ -139,10 +140,11 @@ def _cli(*args):
 def test_cli_train_then_goal_with_the_policy(tmp_path):
     out = tmp_path / "t"
     sets = [x for item in TINY for x in ("--set", item)]
-    done = _cli("train", *sets, "--samples", "150", "--out", str(out), "--no-progress", "--json")
+    done = _cli("train", *sets, "--samples", "150", "--buffer", "fifo", "--out", str(out), "--no-progress", "--json")
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["samples"] >= 150
-    assert json.loads((out / "config.json").read_text())["command"] == "train"
+    config = json.loads((out / "config.json").read_text())
+    assert config["command"] == "train" and config["buffer"]["eviction"] == "fifo"     # --buffer is buffer.eviction
     again = _cli("train", *sets, "--out", str(out), "--no-progress")
     assert again.returncode == 2 and "--resume" in again.stderr and len(again.stderr.strip().splitlines()) == 1
     goal = _cli("goal", "--policy", str(out / "policy.pt"), "--seeds", "1", "--json")
@@ -163,7 +165,8 @@ def test_cli_train_then_goal_with_the_policy(tmp_path):
     assert summary["policy"] == str(out / "policy.pt") and summary["layers"] == followed["layers"]
     distances = [r["mean_distance_m"] for r in summary["runs"]]
     assert len(distances) == 2 and np.all(np.isfinite(distances)) and distances[0] != distances[1]
-    wrong = _cli("follow", "straight_line", "--seconds", "2", "--policy", str(out / "policy.pt"), "--out", str(tmp_path / "g"))
+    wrong = _cli("follow", "straight_line", "--seconds", "2", "--policy", str(out / "policy.pt"),
+                 "--out", str(tmp_path / "g"))
     assert wrong.returncode == 2 and "--stroke front_crawl" in wrong.stderr
     bad = _cli("goal", "--policy", str(tmp_path / "missing.pt"))
     assert bad.returncode == 2 and "no such policy file" in bad.stderr

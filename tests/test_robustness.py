@@ -9,13 +9,13 @@ import time
 import numpy as np
 import pytest
 import yaml
+from test_cli import REPO, assert_one_line_error, cli
 
+from layered_swim.control.stroke import STROKES_DIR
+from layered_swim.control.targets import TRAJECTORIES_DIR
 from layered_swim.episode import Episode
 from layered_swim.outputs import atomic_path
 from layered_swim.recorder import CHUNK_ROWS, read_log
-from layered_swim.control.stroke import STROKES_DIR
-from layered_swim.control.targets import TRAJECTORIES_DIR
-from test_cli import REPO, assert_one_line_error, cli
 
 
 def _stroke_with(tmp_path, **changes):

@@ -3,10 +3,10 @@
 import json
 
 import pytest
+from test_cli import assert_one_line_error, cli
 
 from layered_swim.config import ConfigError
 from layered_swim.spec import FollowTask, SwimSpec
-from test_cli import assert_one_line_error, cli
 
 
 def _logs(folder):

@@ -13,8 +13,7 @@ from layered_swim.config import ConfigError
 from layered_swim.episode import Episode
 from layered_swim.fluid import FluidError, make_fluid
 from layered_swim.fluid.medium import Medium
-from layered_swim.fluid.sph import SphSettings
-from layered_swim.fluid.sph import conveyor
+from layered_swim.fluid.sph import SphSettings, conveyor
 from layered_swim.fluid.sph.backend import start_request
 from layered_swim.fluid.sph.scene import box_obj, pool_slabs
 from layered_swim.fluid.sph.worker import SphWorker
@@ -248,7 +247,8 @@ def test_the_pool_floor_holds_the_swimmer_and_a_deep_start_pose_is_raised_above_
     sim = episode.sim
     floor_z = sim.fluid.pool_min_m[2]
     lowest = body_corners(sim.state.pos_m, sim.state.quat_xyzw, sim.body.half_extents_m)[:, 2].min()
-    assert lowest == pytest.approx(floor_z + FLOOR_CLEARANCE_RADII * COARSE["particle_radius_m"])      # breaststroke's legs reach below 0.5 m
+    # breaststroke's legs reach below 0.5 m
+    assert lowest == pytest.approx(floor_z + FLOOR_CLEARANCE_RADII * COARSE["particle_radius_m"])
     assert sim.fluid.startup["start_raised_m"] > 0
     episode.close()
     assert Episode("breaststroke").sim.fluid.container(sim.state) is None   # open water for the plates

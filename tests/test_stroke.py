@@ -4,9 +4,9 @@ import textwrap
 import numpy as np
 import pytest
 
+from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError
-from layered_swim.body.layout import joint_layout
 from layered_swim.control.stroke import available_strokes, load_stroke
 
 LAYOUT = joint_layout(load_body())

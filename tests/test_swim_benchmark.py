@@ -2,11 +2,19 @@
 import numpy as np
 import pytest
 
-from layered_swim.tasks.swim_benchmark import (
-    ROLL_TOLERANCE_DEG, START_DEPTH_M, SWIM_PUBLISHED, episode_metrics, goal_position, goal_tasks,
-    intermediate_goal, intermediate_goals, pool, straight_line_metrics,
-)
 from layered_swim.config import ConfigError
+from layered_swim.tasks.swim_benchmark import (
+    ROLL_TOLERANCE_DEG,
+    START_DEPTH_M,
+    SWIM_PUBLISHED,
+    episode_metrics,
+    goal_position,
+    goal_tasks,
+    intermediate_goal,
+    intermediate_goals,
+    pool,
+    straight_line_metrics,
+)
 
 LOG_HZ = 60
 SMALL = pool("small")

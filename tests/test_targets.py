@@ -5,8 +5,14 @@ import numpy as np
 import pytest
 
 from layered_swim.config import ConfigError
-from layered_swim.control.targets import (FixedTarget, MovableTarget, StationTarget, Target, TrajectoryTarget,
-                                          available_trajectories, load_trajectory)
+from layered_swim.control.targets import (
+    FixedTarget,
+    MovableTarget,
+    StationTarget,
+    Target,
+    available_trajectories,
+    load_trajectory,
+)
 
 CURVES = {
     "figure_eight": "size_m: {x: 10, y: 5}\ncenter_m: {x: 1, y: -2}\n",
@@ -108,8 +114,8 @@ def test_straight_line_file():
     target = load_trajectory("straight_line")
     np.testing.assert_allclose(target.position(0.0), [2.0, 0.0, -0.3])
     times = np.linspace(0.0, 120.0, 13)
-    np.testing.assert_allclose(positions(target, times), np.column_stack([2 + 0.5 * times, 0 * times, -0.3 + 0 * times]),
-                               atol=1e-9)
+    np.testing.assert_allclose(positions(target, times),
+                               np.column_stack([2 + 0.5 * times, 0 * times, -0.3 + 0 * times]), atol=1e-9)
 
 
 @pytest.mark.parametrize("name", available_trajectories())
@@ -209,7 +215,8 @@ STATIONS = textwrap.dedent("""\
 def test_a_station_target_holds_each_point_until_its_jump(tmp_path):
     target = load_trajectory(write(tmp_path, STATIONS))
     assert isinstance(target, StationTarget) and isinstance(target, Target) and target.kind == "stations"
-    np.testing.assert_allclose(positions(target, [0.0, 24.99, 25.0, 1e4]), [[4, 0, -0.3], [4, 0, -0.3], [4, -8, -1], [4, -8, -1]])
+    np.testing.assert_allclose(positions(target, [0.0, 24.99, 25.0, 1e4]),
+                               [[4, 0, -0.3], [4, 0, -0.3], [4, -8, -1], [4, -8, -1]])
     assert [t for t, _ in target.stations] == [0.0, 25.0]
     np.testing.assert_allclose(target.path_points(), [[4, 0, -0.3], [4, -8, -1]])
 

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from layered_swim.outputs import atomic_path
-
 import matplotlib
 
+from layered_swim.outputs import atomic_path
+
 matplotlib.use("Agg")                  # headless: files only, no display
-import matplotlib.pyplot as plt       # noqa: E402  (the backend must be chosen first)
-import numpy as np                    # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
+import numpy as np  # noqa: E402
 
 DPI = 110
 MIN_ROLL_SPAN_DEG = 5.0
@@ -62,7 +62,8 @@ def speed_figure(result: dict, path: Path) -> None:
     marker = top.twinx()
     marker.plot(ex["time_s"], ex["cycle_marker_m"], color="C1", linewidth=0.9)
     marker.set_ylabel("cycle marker reach (m)", color="C1")
-    top.set_title(f"{result['stroke']}: first analysed cycles; dashed lines = cycle starts (marker rising through its mean)")
+    top.set_title(f"{result['stroke']}: first analysed cycles; dashed lines = cycle starts "
+                  "(marker rising through its mean)")
     band(bottom, profiles["forward_speed_m_s"], "forward speed")
     mean = result["summary"]["mean_speed_m_s"]["mean"]
     bottom.axhline(mean, color="k", linewidth=0.8, label=f"mean {mean:.2f} m/s")
@@ -89,7 +90,8 @@ def propulsion_figure(result: dict, path: Path) -> None:
     profiles = result["profiles"]
     fig, axes = figure(2, 1)
     top, bottom = axes[0, 0], axes[1, 0]
-    ahead, back = ("pushed ahead", "held back") if result["summary"]["thrust_axis"] == "forward" else ("pushed up", "pushed down")
+    ahead, back = (("pushed ahead", "held back") if result["summary"]["thrust_axis"] == "forward"
+                   else ("pushed up", "pushed down"))
     band(top, profiles["propulsive_force_n"], f"propulsive (segments {ahead})", color="C2")
     band(top, profiles["resistive_force_n"], f"resistive (segments {back})", scale=-1.0, color="C3")
     net = np.asarray(profiles["propulsive_force_n"]["mean"]) - np.asarray(profiles["resistive_force_n"]["mean"])
@@ -127,7 +129,8 @@ def attitude_figure(result: dict, path: Path) -> None:
     save(fig, path)
 
 
-COMPARE_PANELS = (("forward_speed_m_s", "forward speed (m/s)"), ("hand_l_thrust_n", "left hand force along the thrust axis (N)"),
+COMPARE_PANELS = (("forward_speed_m_s", "forward speed (m/s)"),
+                  ("hand_l_thrust_n", "left hand force along the thrust axis (N)"),
                   ("joint_power_w", "joint mechanical power (W)"), ("shoulder_roll_deg", "shoulder roll (deg)"))
 
 

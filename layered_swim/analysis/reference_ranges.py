@@ -38,7 +38,8 @@ RANGES: dict[str, dict[str, Range]] = {
         "mean_speed_m_s": Range(0.8, 1.2, "recreational crawl speed (R)"),
         "stroke_rate_cpm": Range(50.0, 55.0, "elite freestyle stroke rate (Hay 1984)"),
         "distance_per_cycle_m": Range(2.2, 2.5, "elite freestyle distance per cycle (Hay 1984)"),
-        "speed_fluctuation_pct": Range(15.0, 20.0, "crawl intracycle speed fluctuation +-15-20 % (Craig & Pendergast 1979)"),
+        "speed_fluctuation_pct": Range(15.0, 20.0, "crawl intracycle speed fluctuation +-15-20 % "
+                                                   "(Craig & Pendergast 1979)"),
         "shoulder_roll_deg": Range(45.0, 60.0, "front-crawl shoulder roll per side (Psycharakis & Sanders 2010)"),
         "hip_roll_deg": Range(30.0, 45.0, "front-crawl hip roll per side (Psycharakis & Sanders 2010)"),
         "peak_hand_force_n": PEAK_HAND_FORCE,
@@ -47,14 +48,16 @@ RANGES: dict[str, dict[str, Range]] = {
         "mean_speed_m_s": BREASTSTROKE_SPEED,
         "stroke_rate_cpm": Range(50.0, 60.0, "elite breaststroke stroke rate (Hay 1984)"),
         "distance_per_cycle_m": Range(1.8, 2.0, "elite breaststroke distance per cycle (Hay 1984)"),
-        "speed_fluctuation_pct": Range(45.0, 50.0, "breaststroke intracycle speed fluctuation +-45-50 % (Craig & Pendergast 1979)"),
+        "speed_fluctuation_pct": Range(45.0, 50.0, "breaststroke intracycle speed fluctuation +-45-50 % "
+                                                   "(Craig & Pendergast 1979)"),
         "peak_hand_force_n": PEAK_HAND_FORCE,
     },
     "backstroke": {
         "mean_speed_m_s": up_to_record(1.94, "backstroke"),
         "stroke_rate_cpm": Range(45.0, 50.0, "elite backstroke stroke rate (Hay 1984)"),
         "distance_per_cycle_m": Range(2.2, 2.4, "elite backstroke distance per cycle (Hay 1984)"),
-        "speed_fluctuation_pct": Range(15.0, 20.0, "backstroke intracycle speed fluctuation +-15-20 % (Craig & Pendergast 1979)"),
+        "speed_fluctuation_pct": Range(15.0, 20.0, "backstroke intracycle speed fluctuation +-15-20 % "
+                                                   "(Craig & Pendergast 1979)"),
         "shoulder_roll_deg": Range(40.0, 50.0, "backstroke shoulder roll per side (R)"),
         "peak_hand_force_n": PEAK_HAND_FORCE,
     },
@@ -62,7 +65,8 @@ RANGES: dict[str, dict[str, Range]] = {
         "mean_speed_m_s": up_to_record(2.02, "butterfly"),
         "stroke_rate_cpm": Range(50.0, 55.0, "elite butterfly stroke rate (Hay 1984)"),
         "distance_per_cycle_m": Range(2.0, 2.1, "elite butterfly distance per cycle (Hay 1984)"),
-        "speed_fluctuation_pct": Range(45.0, 50.0, "butterfly intracycle speed fluctuation +-45-50 % (Craig & Pendergast 1979)"),
+        "speed_fluctuation_pct": Range(45.0, 50.0, "butterfly intracycle speed fluctuation +-45-50 % "
+                                                   "(Craig & Pendergast 1979)"),
         "peak_hand_force_n": PEAK_HAND_FORCE,
     },
     "treading_water": {

@@ -43,7 +43,8 @@ DEFINITIONS = """\
   steady swimming it equals the mean propulsive force). Counting per segment, limbs recovering
   against the water count as drag, so this is larger than a whole-body measurement would be.
 - **Mechanical power**: the stable-PD torques the joints applied (they close the energy balance
-  of a swim) times the joint rates, summed over joints and averaged over the cycle. **Propelling efficiency** = active drag x mean speed / mechanical power.
+  of a swim) times the joint rates, summed over joints and averaged over the cycle. \
+**Propelling efficiency** = active drag x mean speed / mechanical power.
 """
 
 
@@ -99,7 +100,8 @@ def analysis_report(result: dict, table: list[dict], plot_files: list[str]) -> s
                      "Bottom: forward speed over the normalised cycle.",
         "limb_forces.png": "Force of the water on each hand and foot over the cycle: magnitude and the part along "
                            "the thrust axis (positive pushes the swimmer on).",
-        "propulsion_power.png": "Propulsive and resistive force summed over segments, and the joints' mechanical power.",
+        "propulsion_power.png": "Propulsive and resistive force summed over segments, and the joints' "
+                                "mechanical power.",
         "attitude.png": "Shoulder and hip roll, pelvis pitch and head height over the cycle.",
     }
     for name in plot_files:

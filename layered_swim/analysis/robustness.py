@@ -15,8 +15,8 @@ import numpy as np
 from layered_swim.analysis.sweep import run_sweep
 from layered_swim.config import ConfigError
 from layered_swim.episode import WIDE_JITTER
-from layered_swim.outputs import COMMAND_KEY, OutputFolder, claim, write_json
 from layered_swim.learned import steering_for
+from layered_swim.outputs import COMMAND_KEY, OutputFolder, claim, write_json
 from layered_swim.runs import follow_run, versions
 from layered_swim.spec import MIN_SECONDS, SwimSpec
 

@@ -26,11 +26,11 @@ import numpy as np
 
 from layered_swim.analysis.drag import REFERENCE_PASSIVE_DRAG_N_S2_M2, glide_state
 from layered_swim.body.model import load_body
+from layered_swim.fluid.backend import FluidError
 from layered_swim.fluid.coefficients import build_coefficient_table
 from layered_swim.fluid.medium import Medium
 from layered_swim.fluid.plate import _plate_wrenches
 from layered_swim.fluid.sph import SphSettings
-from layered_swim.fluid.backend import FluidError
 from layered_swim.fluid.sph.backend import HEADROOM_M, MAX_WATER_SPEED_M_S, boundary_boxes, start_request
 from layered_swim.fluid.sph.worker import SphWorker
 from layered_swim.sim.simulation import GRAVITY_M_S2

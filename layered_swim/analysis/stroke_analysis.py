@@ -13,7 +13,6 @@ from pathlib import Path
 from layered_swim.analysis import plots, report
 from layered_swim.analysis.drag import towed_drag
 from layered_swim.analysis.files import write_csv
-from layered_swim.tasks.metrics import SETTLE_S
 from layered_swim.analysis.reference_ranges import ranges_for
 from layered_swim.analysis.stroke_metrics import SwimmerInfo, analyze_log
 from layered_swim.analysis.sweep import file_sha256, run_sweep
@@ -25,6 +24,7 @@ from layered_swim.recorder import logged_names, read_log
 from layered_swim.runs import check_seconds, record, resolved_config
 from layered_swim.sim.simulation import PHYSICS_HZ
 from layered_swim.spec import SwimSpec
+from layered_swim.tasks.metrics import SETTLE_S
 
 ANALYSIS_LOG_HZ = 120      # ~100 samples per stroke cycle for the profiles
 PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_figure,
@@ -33,7 +33,8 @@ PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_fi
 
 def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | None = None,
                     current_m_s=(0.0, 0.0, 0.0), fluid: str = "fresh_water", settle_s: float = SETTLE_S,
-                    seed: int = 0, physics_hz: int | None = None, backend: str = "plate", sph: dict | None = None) -> dict:
+                    seed: int = 0, physics_hz: int | None = None, backend: str = "plate",
+                    sph: dict | None = None) -> dict:
     """The resolved, JSON-able configuration of one analysis (also its cache key); ``sph``: the
     SPH settings' fields, with ``backend="sph"``."""
     check_seconds(seconds)
@@ -41,7 +42,8 @@ def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | N
         raise ConfigError(f"settle time must be at least 0 and shorter than the swim ({seconds:g} s), got {settle_s}")
     return {"stroke": stroke, "stroke_file_sha256": file_sha256(stroke_path(stroke)), "seconds": float(seconds),
             "density_kg_m3": density_kg_m3, "current_m_s": [float(c) for c in current_m_s], "fluid": fluid,
-            "settle_s": float(settle_s), "seed": seed, "physics_hz": physics_hz or PHYSICS_HZ, "backend": backend, "sph": sph}
+            "settle_s": float(settle_s), "seed": seed, "physics_hz": physics_hz or PHYSICS_HZ, "backend": backend,
+            "sph": sph}
 
 
 def analysis_spec(config: dict) -> SwimSpec:
@@ -66,13 +68,15 @@ def analyze_stroke(config: dict, progress: bool = False) -> dict:
     speed = summary["mean_speed_m_s"]["mean"]
     # The same body towed in a streamlined glide at the swimming speed: what the stroke adds. A
     # fluid with memory (SPH) cannot be read in one evaluation: `validate sph` tows it instead.
-    towed = make_fluid(sim.fluid.name, sim.body, sim.fluid.medium, sim.config.gravity_m_s2) if settings is None else None
+    towed = (make_fluid(sim.fluid.name, sim.body, sim.fluid.medium, sim.config.gravity_m_s2)
+             if settings is None else None)
     summary["passive_drag_n"] = (towed_drag(towed, (abs(speed),))[0]["drag_n"]
                                  if posture == "prone" and towed is not None else None)
     summary["nominal_stroke_rate_cpm"] = 60.0 / stroke.period_s
     return {"stroke": stroke.name, "posture": posture, **result,
-            "config": resolved_config(episode, spec, "analyze", analysis=_settings(config["seconds"], config["settle_s"],
-                                                                             stroke_file_sha256=config["stroke_file_sha256"]))}
+            "config": resolved_config(episode, spec, "analyze",
+                                      analysis=_settings(config["seconds"], config["settle_s"],
+                                                         stroke_file_sha256=config["stroke_file_sha256"]))}
 
 
 def _settings(seconds: float, settle_s: float, **more) -> dict:
@@ -103,7 +107,8 @@ def analyze_run(run_dir: str | Path, settle_s: float = SETTLE_S) -> dict:
     result["summary"]["nominal_stroke_rate_cpm"] = 60.0 / period_s
     analysis = _settings(float(log["time_s"][-1]), settle_s, run_dir=str(run_dir),
                          partial_log=bool(log["partial"]) or _stopped_early(run_dir))
-    return {"stroke": name, "posture": posture, **result, "config": {**config, COMMAND_KEY: "analyze", "analysis": analysis}}
+    return {"stroke": name, "posture": posture, **result,
+            "config": {**config, COMMAND_KEY: "analyze", "analysis": analysis}}
 
 
 def _stopped_early(run_dir: Path) -> bool:

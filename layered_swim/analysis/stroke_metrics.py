@@ -13,11 +13,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from layered_swim.analysis.cycles import cycle_means, cycle_starts, resample_cycles
-from layered_swim.tasks.metrics import roll_deg
 from layered_swim.config import ConfigError
-from layered_swim.geometry import quat_rotate
 from layered_swim.control.steering import FORWARD_LOCAL
+from layered_swim.geometry import quat_rotate
 from layered_swim.state import lying
+from layered_swim.tasks.metrics import roll_deg
 
 PELVIS_LONG_AXIS_LOCAL = np.array([0.0, 0.0, 1.0])
 LIMBS = ("hand_l", "hand_r", "foot_l", "foot_r")
@@ -123,7 +123,8 @@ def analyze_log(log: dict, info: SwimmerInfo) -> dict:
     rows = _cycle_rows(t, window, starts, forward, profiles, travels)
     summary = {name: _stats(values) for name, values in rows.items() if name != "start_s"}
     for limb in ("hand", "foot"):
-        summary[f"peak_{limb}_force_n"] = _stats(np.maximum(rows[f"peak_{limb}_l_force_n"], rows[f"peak_{limb}_r_force_n"]))
+        summary[f"peak_{limb}_force_n"] = _stats(np.maximum(rows[f"peak_{limb}_l_force_n"],
+                                                            rows[f"peak_{limb}_r_force_n"]))
     speed = summary["mean_speed_m_s"]["mean"]
     drag = summary["resistive_force_n"]["mean"] if travels else None
     summary.update({
@@ -133,7 +134,8 @@ def analyze_log(log: dict, info: SwimmerInfo) -> dict:
         "thrust_axis": "forward" if travels else "up",
         "active_drag_n": drag,
         "active_drag_per_v2_kg_m": drag / speed**2 if travels else None,
-        "propelling_efficiency": propelling_efficiency(drag, speed, summary["mechanical_power_w"]["mean"]) if travels else None,
+        "propelling_efficiency": (propelling_efficiency(drag, speed, summary["mechanical_power_w"]["mean"])
+                                  if travels else None),
     })
     return {
         "summary": summary,

@@ -4,9 +4,10 @@ A job is a JSON-able configuration dict and a task, a module-level function (pic
 configuration to a JSON-able result. The cache key is a hash of the task's name, the
 configuration, the task's own module and the package's other source (so an edited simulator
 never serves stale results; modules that only draw or write results are left out).
-Configurations that depend on files people edit carry those files' hashes (``file_sha256``). A re-run computes only the keys missing from the cache; results are saved
-as each job finishes, so an interrupted sweep keeps what it had done. Every job is seeded and
-deterministic, so the number of workers never changes a result.
+Configurations that depend on files people edit carry those files' hashes (``file_sha256``). A
+re-run computes only the keys missing from the cache; results are saved as each job finishes, so
+an interrupted sweep keeps what it had done. Every job is seeded and deterministic, so the number
+of workers never changes a result.
 """
 from __future__ import annotations
 

@@ -11,10 +11,12 @@ from layered_swim.commands.tables import summary_rows, table
 
 
 def add_parser(subparsers) -> None:
-    analyze = subparsers.add_parser("analyze", help="swim steadily and report per-cycle stroke metrics, plots and a report")
+    analyze = subparsers.add_parser("analyze", help="swim steadily and report per-cycle stroke metrics, plots "
+                                                    "and a report")
     what = analyze.add_mutually_exclusive_group(required=True)
     what.add_argument("--stroke", help="stroke name (see `strokes`) or path to a stroke .yaml: swim it now")
-    what.add_argument("--run", metavar="DIR", help="analyze the log of a `run` folder instead (a stopped, partial one too)")
+    what.add_argument("--run", metavar="DIR", help="analyze the log of a `run` folder instead (a stopped, "
+                                                   "partial one too)")
     analysis_options(analyze)
     analyze.add_argument("--out", help="output folder (default runs/analyze-<stroke>-<timestamp>)")
 

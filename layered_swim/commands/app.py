@@ -25,10 +25,12 @@ def add_parser(subparsers) -> None:
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The app's options, on its sub-parser or on app.py's own parser (``cli.main(command="app")``)."""
     p.add_argument("--stroke", default="breaststroke",
-                   help="stroke name, path to a stroke .yaml, or auto (chooses and switches strokes; default breaststroke)")
+                   help="stroke name, path to a stroke .yaml, or auto (chooses and switches strokes; "
+                        "default breaststroke)")
     p.add_argument("--trajectory", help="a trajectory name or .yaml file: show its path and chase its target")
     p.add_argument("--backend", default="plate",
-                   help="fluid model; the window runs only plate (SPH is ~20x slower than real time: use `layered-swim render --backend sph`)")
+                   help="fluid model; the window runs only plate (SPH is ~20x slower than real time: "
+                        "use `layered-swim render --backend sph`)")
     steering_options(p)   # --layers (keys toggle them), --current, --density
     p.add_argument("--policy", metavar="FILE", help="a trained residual (policy.pt from `layered-swim train`) drives "
                                                      "its stroke (needs the [rl] extra)")
@@ -52,9 +54,9 @@ def run(args) -> None:
         raise ConfigError(f"--benchmark-frames must be at least 2, got {args.benchmark_frames}")
     policy = None
     if args.policy:
-        from layered_swim.rl.policy import Policy
+        from layered_swim.rl.policy import ResidualPolicy
 
-        policy = Policy.load(args.policy)
+        policy = ResidualPolicy.load(args.policy)
     session = SwimSession(args.stroke, Layers.parse(args.layers), vector(args.current, "--current"), args.density,
                           args.trajectory, policy=policy)
     if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):

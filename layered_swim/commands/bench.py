@@ -11,9 +11,11 @@ from layered_swim.commands.tables import fmt, table
 def add_parser(subparsers) -> None:
     bench = subparsers.add_parser("bench", help="time one physics step, bare and through the whole loop")
     bench.add_argument("--json", action="store_true")
-    bench.add_argument("--seconds", type=float, help="simulated seconds per repeat (default 5; 0.5 with SPH; 10 with --env)")
+    bench.add_argument("--seconds", type=float,
+                       help="simulated seconds per repeat (default 5; 0.5 with SPH; 10 with --env)")
     bench.add_argument("--env", action="store_true", help="time the RL environment: steps per second on one core and "
-                                                          "the shares of physics, observation, reward and policy ([rl] extra)")
+                                                          "the shares of physics, observation, reward and policy "
+                                                          "([rl] extra)")
     bench.add_argument("--physics-hz", type=int, help="physics rate in Hz (default 480)")
     backend_option(bench)
 

@@ -8,16 +8,17 @@ from layered_swim.commands.tables import table
 
 
 def add_parser(subparsers) -> None:
-    calibrate = subparsers.add_parser("calibrate", help="measure each perturbation sequence's turn per cycle (Yang 4.3)")
+    calibrate = subparsers.add_parser("calibrate",
+                                      help="measure each perturbation sequence's turn per cycle (Yang 4.3)")
     calibrate.add_argument("--stroke", required=True, help="stroke name or path to a stroke .yaml")
     parallel_options(calibrate)
 
 
 def run(args) -> None:
-    from layered_swim.body.model import load_body
     from layered_swim.analysis.calibrate import calibrate
-    from layered_swim.control.calibration import calibration_path, save_table
     from layered_swim.body.layout import joint_layout
+    from layered_swim.body.model import load_body
+    from layered_swim.control.calibration import calibration_path, save_table
     from layered_swim.control.stroke import load_stroke
 
     stroke = load_stroke(args.stroke, joint_layout(load_body()))

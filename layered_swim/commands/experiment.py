@@ -4,13 +4,20 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from layered_swim.commands.options import (backend_option, fluid_settings, out_dir, overwrite_option,
-                                           parallel_options, progress)
+from layered_swim.commands.options import (
+    backend_option,
+    fluid_settings,
+    out_dir,
+    overwrite_option,
+    parallel_options,
+    progress,
+)
 from layered_swim.commands.tables import table
 
 
 def add_parser(subparsers) -> None:
-    experiment = subparsers.add_parser("experiment", help="reproduce one of the papers' experiments (figure + CSV + report)")
+    experiment = subparsers.add_parser("experiment",
+                                       help="reproduce one of the papers' experiments (figure + CSV + report)")
     experiment.add_argument("name", help="experiment name; `layered-swim experiment list` lists them")
     experiment.add_argument("--out", help="output folder (default runs/experiment-<name>)")
     overwrite_option(experiment)

@@ -4,8 +4,18 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from layered_swim.commands.options import (backend_option, count, medium, out_dir, overwrite_option, parallel_options,
-                                           progress, steering_options, swim_spec)
+from layered_swim.commands.export import export_option, export_swim, export_target
+from layered_swim.commands.options import (
+    backend_option,
+    count,
+    medium,
+    out_dir,
+    overwrite_option,
+    parallel_options,
+    progress,
+    steering_options,
+    swim_spec,
+)
 from layered_swim.commands.tables import fmt, table
 
 
@@ -19,6 +29,7 @@ def add_parser(subparsers) -> None:
     follow.add_argument("--out", help="output folder (default runs/follow-<trajectory>-<timestamp>)")
     overwrite_option(follow)
     follow.add_argument("--json", action="store_true")
+    export_option(follow)
     follow.add_argument("--policy", metavar="FILE", help="a trained residual (policy.pt from `train`) on its reference "
                                                           "controller (--layers then comes from the policy)")
     follow.add_argument("--seeds", type=count(1, 1000), metavar="N",
@@ -38,7 +49,9 @@ def run(args) -> None:
         _follow_seeds(args, spec)
         return
     out = out_dir(args, default_out_dir(f"follow-{Path(args.trajectory).stem}"))
+    target = export_target(args)
     result = follow_run(spec, out, steering_for(spec))
+    result.update(export_swim(target, out.path))
     if args.json:
         print(json.dumps({**result, "out_dir": str(out.path)}, allow_nan=False))
         return
@@ -55,6 +68,8 @@ def _follow_seeds(args, spec) -> None:
 
     if args.backend != "plate":
         raise ConfigError("--seeds runs on the plate backend only (no --backend sph)")
+    if args.export:
+        raise ConfigError("--export writes one swim: not with --seeds")
     out = out_dir(args, default_out_dir(f"follow-{Path(args.trajectory).stem}-seeds"))
     summary = follow_seeds(spec, args.seeds, out, args.workers, progress(args))
     if args.json:

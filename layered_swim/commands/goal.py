@@ -4,8 +4,16 @@ from __future__ import annotations
 
 import json
 
-from layered_swim.commands.options import (backend_option, count, medium, out_dir, overwrite_option, steering_options,
-                                           swim_spec, vector)
+from layered_swim.commands.options import (
+    backend_option,
+    count,
+    medium,
+    out_dir,
+    overwrite_option,
+    steering_options,
+    swim_spec,
+    vector,
+)
 from layered_swim.commands.tables import fmt, table
 
 DEFAULT_STROKE = "front_crawl"      # without --policy; with one, the policy's own stroke
@@ -62,18 +70,18 @@ def _spec(args, stroke: str):
 def _goal_policy(args) -> None:
     import numpy as np
 
-    from layered_swim.rl.policy import Policy, evaluate_goals
+    from layered_swim.rl.policy import ResidualPolicy, evaluate_goals
     from layered_swim.runs import goal_run
     from layered_swim.tasks.goal import GOAL_METRICS
 
-    policy = Policy.load(args.policy)
+    policy = ResidualPolicy.load(args.policy)
     policy.check_stroke(args.stroke)
-    stroke, current = policy.env["stroke"], vector(args.current, "--current")
+    stroke, current = policy.env.stroke, vector(args.current, "--current")
     spec = _spec(args, stroke)
     result = evaluate_goals(policy, args.seeds, pool=args.pool, backend=args.backend,
                             fluid_settings=spec.fluid_settings(), current_m_s=tuple(current))
     heuristic = goal_run(spec)
-    result = {"policy": args.policy, "pool": args.pool, "stroke": stroke, "reference": policy.env["reference"],
+    result = {"policy": args.policy, "pool": args.pool, "stroke": stroke, "reference": policy.env.reference,
               "fluid_backend": args.backend, "current_m_s": list(current), "seeds": args.seeds, **result,
               "heuristic": {k: heuristic[k] for k in GOAL_METRICS}, "swim_published": heuristic["swim_published"]}
     if args.json:

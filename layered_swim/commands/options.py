@@ -53,7 +53,8 @@ def backend_option(command: argparse.ArgumentParser, pool: str | None = "small")
     """--backend and the SPH water's options (used only with --backend sph); ``pool``: the
     default SPH pool (None: the command has its own --pool)."""
     command.add_argument("--backend", default="plate",
-                         help="fluid model: plate (thin plates + buoyancy, default) or sph (SPlisHSPlasH, the [sph] extra)")
+                         help="fluid model: plate (thin plates + buoyancy, default) or sph (SPlisHSPlasH, "
+                              "the [sph] extra)")
     sph = command.add_argument_group("SPH water (with --backend sph)")
     if pool:
         sph.add_argument("--pool", choices=("small", "large"), default=pool,
@@ -105,7 +106,8 @@ def steering_options(command: argparse.ArgumentParser, density: bool = True) -> 
 def analysis_options(command: argparse.ArgumentParser) -> None:
     """The options of a steady swim analysed per cycle (``analyze``, ``compare``)."""
     command.add_argument("--seconds", type=float, default=60.0, help="simulated seconds (default 60)")
-    command.add_argument("--settle", type=float, default=5.0, metavar="S", help="seconds left out at the start (default 5)")
+    command.add_argument("--settle", type=float, default=5.0, metavar="S",
+                         help="seconds left out at the start (default 5)")
     water_options(command)
     current_option(command)
     command.add_argument("--json", action="store_true", help="print the summary as one JSON object")

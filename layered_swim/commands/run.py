@@ -5,8 +5,8 @@ from __future__ import annotations
 import json
 import sys
 
-from layered_swim.commands.options import (backend_option, medium, out_dir, overwrite_option, swim_spec,
-                                           water_options)
+from layered_swim.commands.export import export_option, export_swim, export_target
+from layered_swim.commands.options import backend_option, medium, out_dir, overwrite_option, swim_spec, water_options
 from layered_swim.commands.tables import flat, fmt, table
 
 # What describes the swim itself: with --config these come from the file, so none may be given.
@@ -25,6 +25,7 @@ def add_parser(subparsers) -> None:
     command.add_argument("--out", help="output folder (default runs/<stroke>-<timestamp>)")
     overwrite_option(command)
     command.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    export_option(command)
     command.add_argument("--lung-volume", type=float, dest="lung_air_l", metavar="L",
                          help="inhaled air in litres, on top of the residual volume (default 3)")
     water_options(command)
@@ -41,7 +42,9 @@ def run(args) -> None:
     spec = swim_spec(args, args.stroke, {"kind": "free"}, seconds=args.seconds, medium=medium(args, current=False),
                      physics_hz=args.physics_hz, tempo=args.tempo, lung_air_l=args.lung_air_l, seed=args.seed)
     out = out_dir(args, default_out_dir(args.stroke))
+    target = export_target(args)
     result = run_swim(spec, out, progress=not args.json and sys.stderr.isatty())
+    result.update(export_swim(target, out.path))
     _report(args, result, out.path, "summary.json, config.json, log.npz, timeseries.csv")
 
 
@@ -55,12 +58,17 @@ def _repeat(args) -> None:
     if given:
         raise ConfigError(f"--config repeats the swim as its file describes it: drop {', '.join(given)}")
     command, spec = repeatable(args.config)
+    if command == "goal" and args.export:
+        raise ConfigError("--export writes one swim, and a goal folder holds one per goal: export its goal-<k> "
+                          "folders with `layered-swim export`")
     default = default_out_dir(f"{command}-{spec.stroke}")
     out = check_out_dir(default if args.out is None else args.out, command, args.overwrite)
+    target = export_target(args)
     if command == "follow":
         result = follow_run(spec, out, steering_for(spec))
     else:
         result = {"run": run_swim, "goal": goal_run}[command](spec, out)
+    result.update(export_swim(target, out.path))
     _report(args, result, out.path, f"the `{command}` swim of {args.config}")
 
 

@@ -9,9 +9,9 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> None:
+    from layered_swim.body.layout import joint_layout
     from layered_swim.body.model import load_body
     from layered_swim.config import ConfigError
-    from layered_swim.body.layout import joint_layout
     from layered_swim.control.auto import AUTO, AUTO_STROKES
     from layered_swim.control.stroke import available_strokes, load_stroke
 
@@ -26,7 +26,8 @@ def run(args) -> None:
         first_line = (stroke.description.strip().splitlines() or [""])[0]
         rows.append([name, f"{60.0 / stroke.period_s:.1f}", _speed_range(stroke), first_line])
     print(table(rows, ["stroke", "cycles/min", "speed m/s", "description"]))
-    print(f"\n{AUTO}: chases a target with {', '.join(AUTO_STROKES)}, switched between cycles (follow, goal, render, the app)")
+    print(f"\n{AUTO}: chases a target with {', '.join(AUTO_STROKES)}, switched between cycles "
+          "(follow, goal, render, the app)")
 
 
 def _speed_range(stroke) -> str:

@@ -14,9 +14,11 @@ def add_parser(subparsers) -> None:
     train.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="override a field, e.g. --set ppo.learning_rate=1e-4 (repeatable)")
     train.add_argument("--samples", type=count(1, 10**10), help="environment steps in all (run.samples)")
-    train.add_argument("--workers", type=count(1, MAX_WORKERS), help="rollout worker processes (run.workers; default 2)")
-    train.add_argument("--buffer", choices=("fifo", "progevict"), help="episode buffer eviction (buffer.policy)")
-    train.add_argument("--ray", metavar="ADDRESS", help="run the rollout workers on a Ray cluster ('local': start one here)")
+    train.add_argument("--workers", type=count(1, MAX_WORKERS),
+                       help="rollout worker processes (run.workers; default 2)")
+    train.add_argument("--buffer", choices=("fifo", "progevict"), help="episode buffer eviction (buffer.eviction)")
+    train.add_argument("--ray", metavar="ADDRESS",
+                       help="run the rollout workers on a Ray cluster ('local': start one here)")
     train.add_argument("--out", help="output folder (default runs/train-<stroke>)")
     train.add_argument("--resume", action="store_true", help="continue the training in --out from its checkpoint")
     overwrite_option(train)
@@ -30,7 +32,7 @@ def run(args) -> None:
     from layered_swim.rl.train import CHECKPOINT, train
 
     overrides = list(args.set)
-    for key, value in (("run.samples", args.samples), ("run.workers", args.workers), ("buffer.policy", args.buffer)):
+    for key, value in (("run.samples", args.samples), ("run.workers", args.workers), ("buffer.eviction", args.buffer)):
         if value is not None:
             overrides.append(f"{key}={value}")
     spec = load_train_spec(args.config, overrides)

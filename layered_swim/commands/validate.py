@@ -42,8 +42,8 @@ def run(args) -> None:
 
 def _validate_sph(args) -> None:
     from layered_swim.analysis.sph_validation import validate_sph
-    from layered_swim.fluid import make_fluid
     from layered_swim.body.model import load_body
+    from layered_swim.fluid import make_fluid
     from layered_swim.fluid.medium import Medium
     from layered_swim.sim.simulation import GRAVITY_M_S2
 
@@ -57,13 +57,15 @@ def _validate_sph(args) -> None:
     for label in ("before", "after"):
         part = result[label]
         print(f"\n{label} the correction (boxes shrunk by {result['mesh_shrink_radii'] if label == 'after' else 0:g} "
-              f"particle radii per side; r = {result['particle_radius_m']:g} m; means of {1000 * result['window_s']:g} ms windows)")
+              f"particle radii per side; r = {result['particle_radius_m']:g} m; "
+              f"means of {1000 * result['window_s']:g} ms windows)")
         rows = [[name, f"{part[key]['lift_n']:.1f} +- {part[key]['window_sd_n']:.1f}", f"{part[key]['rho_g_v_n']:.1f}",
                  f"{part[key]['ratio']:.3f}"] for name, key in (("torso box, full", "held_box_full"),
                                                                 ("torso box, half", "held_box_half"))]
         print(table(rows, ["held box", "SPH lift N", "rho g V N", "ratio"]))
         f = part["floating_box"]
-        print(table([["0.3 x 0.3 x 0.2 m, 500 kg/m3", f"{f['draft_m']:.4f}", f"{f['expected_m']:.4f}", f"{f['ratio']:.3f}"]],
+        print(table([["0.3 x 0.3 x 0.2 m, 500 kg/m3", f"{f['draft_m']:.4f}", f"{f['expected_m']:.4f}",
+                      f"{f['ratio']:.3f}"]],
                     ["floating box", "SPH draft m", "expected m", "ratio"]))
         print(table([[f"{r['angle_deg']:g}", f"{r['speed_m_s']:g}", f"{r['drag_n']:.1f} +- {r['window_sd_n']:.1f}",
                       f"{r['plate_model_n']:.1f}", fmt(r["ratio"])] for r in part["towed_plate"]],

@@ -22,13 +22,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from layered_swim.control.layered import LayeredController
-from layered_swim.geometry import ease
 from layered_swim.control.steering import attitude_of, bearing_error
 from layered_swim.control.targets import Target, target_speed_m_s
+from layered_swim.geometry import ease
 from layered_swim.state import BodyState
 
 AUTO = "auto"
@@ -62,6 +63,13 @@ class StrokeChoice:
         return TURN
 
 
+class Switch(NamedTuple):
+    """One change of stroke: when, and to which."""
+
+    time_s: float
+    stroke: str
+
+
 class AutoStrokeController:
     """Several strokes' layered controllers, one swimming at a time, switched by ``choice``."""
 
@@ -74,7 +82,7 @@ class AutoStrokeController:
         self.active = self.first
         for controller in self.controllers.values():
             controller.reset()
-        self.switches: list[tuple[float, str]] = []
+        self.switches: list[Switch] = []
         self.lung_air_l: float | None = self.current.lung_air_l    # kept through strokes that do not breathe
         self._from_pose: np.ndarray | None = None
         self._last_pose: np.ndarray | None = None
@@ -153,4 +161,4 @@ class AutoStrokeController:
         self.current.restart(time_s)
         if self.current.lung_air_l is not None and self.lung_air_l is not None:
             self.current.lung_air_l = self.lung_air_l        # the breath held goes on
-        self.switches.append((time_s, name))
+        self.switches.append(Switch(time_s, name))

@@ -23,6 +23,7 @@ class StrokeController:
     def reset(self) -> None:
         """Stateless: the phase is a function of time."""
 
-    def desired(self, time_s: float, state: BodyState | None, flow_m_s: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    def desired(self, time_s: float, state: BodyState | None,
+                flow_m_s: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
         pose, rate = self.stroke.pose(self.phase(time_s))
         return pose, rate * self.cycles_per_s

@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 import yaml
-
 from pydantic import Field, model_validator
 
 from layered_swim.config import ConfigError, Degrees, Strict, between, load
@@ -175,6 +174,7 @@ def load_table(stroke: Stroke, directory: Path | None = None) -> CalibrationTabl
                                f"'steering.max_weight' is {stroke.steering.max_weight:g}; {remake}")
     return CalibrationTable(
         stroke=spec.stroke, stroke_sha256=spec.stroke_sha256, weights=tuple(spec.weights), tempos=tuple(spec.tempos),
-        pace=Pace(tuple(spec.pace.tempos), tuple(spec.pace.speed_m_s), tuple(math.radians(a) for a in spec.pace.roll_deg),
+        pace=Pace(tuple(spec.pace.tempos), tuple(spec.pace.speed_m_s),
+                  tuple(math.radians(a) for a in spec.pace.roll_deg),
                   tuple(math.radians(a) for a in spec.pace.pitch_deg), tuple(spec.pace.depth_m)),
         turn_rad={name: np.radians(np.array(rows, dtype=float)) for name, rows in spec.turn_deg_per_cycle.items()})

@@ -1,7 +1,8 @@
 """The layered controller (Yang section 4): basic stroke + per-cycle perturbations + rules.
 
-At the start of every stroke cycle a weight policy picks one weight per perturbation sequence
-(and the cycle's tempo); the weights scale and blend the sequences' offsets into the basic pose
+At the start of every stroke cycle a chooser (a ``CycleChooser``: ``cycle_choice.TargetChooser``
+steering toward a target, or ``fixed_weights``) picks one weight per perturbation sequence (and
+the cycle's tempo); the weights scale and blend the sequences' offsets into the basic pose
 for that whole cycle. Every control step the continuous rules adjust the blended pose from the
 water flowing past the hands. Layers can be switched off one by one (``Layers``). A stroke that
 breathes to steer (``steering.breathe``) also sets the air in the lungs toward the target's depth
@@ -22,7 +23,6 @@ from layered_swim.control.stroke import ALL_SEQUENCES, Stroke
 from layered_swim.control.targets import Target
 from layered_swim.geometry import ease, unit_vector
 from layered_swim.state import BodyState, JointLayout
-
 
 BLEND_CYCLES = 0.15   # a new cycle's weights take over within this fraction of it
 
@@ -45,7 +45,8 @@ class Layers:
 
     def describe(self) -> str:
         parts = ["basic"] + (["cycle"] if self.cycle else [])
-        parts += ["rules"] if self.palm and self.reach else (["palm"] if self.palm else []) + (["reach"] if self.reach else [])
+        parts += (["rules"] if self.palm and self.reach
+                  else (["palm"] if self.palm else []) + (["reach"] if self.reach else []))
         return ",".join(parts)
 
 
@@ -59,16 +60,19 @@ class CycleChoice:
     thrust_demand: float = 1.0   # 0..1: how much more force the rules should seek this cycle
 
 
-class WeightPolicy(Protocol):
+class CycleChooser(Protocol):
+    """The per-cycle layer's decision rule: called at each cycle start with the cycle's number, the
+    body state and the shoulder roll averaged over the last cycle (None before one has ended)."""
+
     def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice: ...
 
 
 class LayeredController:
-    def __init__(self, stroke: Stroke, layout: JointLayout, arms: list[ArmIndices], policy: WeightPolicy,
+    def __init__(self, stroke: Stroke, layout: JointLayout, arms: list[ArmIndices], chooser: CycleChooser,
                  layers: Layers = Layers(), target: Target | None = None, lungs: LungControl | None = None):
-        """``target``: where the rules push toward; without one, straight ahead (scripted policies).
+        """``target``: where the rules push toward; without one, straight ahead (scripted weights).
         ``lungs``: breathe toward the target's depth (needs a target)."""
-        self.stroke, self.layout, self.arms, self.policy, self.layers = stroke, layout, arms, policy, layers
+        self.stroke, self.layout, self.arms, self.chooser, self.layers = stroke, layout, arms, chooser, layers
         self.target = target
         self.lungs = lungs if target is not None else None
         self.reset()
@@ -116,7 +120,7 @@ class LayeredController:
         self._previous_weights = dict(self.choice.weights)   # fully blended in by the cycle's end
         self._roll_sum, self._roll_n = 0.0, 0
         if state is not None:
-            self.choice = self.policy(self.cycle, state, self.last_mean_roll_rad)
+            self.choice = self.chooser(self.cycle, state, self.last_mean_roll_rad)
             if not self.layers.cycle:
                 self.choice = CycleChoice(tempo=self.choice.tempo)
 
@@ -167,7 +171,8 @@ class LayeredController:
         eased = ease(progress)
         # A fixed order: the offsets are summed in it, and a set's order changes with the hash seed.
         names = [n for n in ALL_SEQUENCES if n in self.choice.weights or n in self._previous_weights]
-        return {n: self._previous_weights.get(n, 0.0) + eased * (self.choice.weights.get(n, 0.0) - self._previous_weights.get(n, 0.0))
+        return {n: self._previous_weights.get(n, 0.0)
+                + eased * (self.choice.weights.get(n, 0.0) - self._previous_weights.get(n, 0.0))
                 for n in names}
 
     def _engagement(self, state: BodyState, desired: np.ndarray) -> float:
@@ -192,12 +197,12 @@ class LayeredController:
         self._roll_n += 1
 
 
-def fixed_weights(weights: dict[str, float], from_cycle: int = 0, tempo: float = 1.0) -> WeightPolicy:
-    """A scripted policy: ``weights`` from cycle ``from_cycle`` on (calibration, experiments)."""
+def fixed_weights(weights: dict[str, float], from_cycle: int = 0, tempo: float = 1.0) -> CycleChooser:
+    """A scripted chooser: ``weights`` from cycle ``from_cycle`` on (calibration, experiments)."""
     unknown = set(weights) - set(ALL_SEQUENCES)
     if unknown:
         raise ValueError(f"unknown perturbation sequences {sorted(unknown)}")
 
-    def policy(cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
+    def chooser(cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
         return CycleChoice(dict(weights) if cycle >= from_cycle else {}, tempo)
-    return policy
+    return chooser

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from layered_swim.body.model import Body
+from layered_swim.control.stroke import RulesSpec
 from layered_swim.geometry import quat_rotate
 from layered_swim.state import JointLayout
-from layered_swim.control.stroke import RulesSpec
 
 PALM_NORMAL_LOCAL = np.array([0.0, 1.0, 0.0])   # the hand box's thin axis
 MIN_FLOW_M_S = 0.05                             # below this the hand feels no useful force

@@ -18,7 +18,17 @@ import numpy as np
 from pydantic import Field, model_validator
 from scipy.interpolate import PchipInterpolator
 
-from layered_swim.config import SHIPPED_DIR, ConfigError, Degrees, Strict, available_files, between, file_path, load, search_dirs
+from layered_swim.config import (
+    SHIPPED_DIR,
+    ConfigError,
+    Degrees,
+    Strict,
+    available_files,
+    between,
+    file_path,
+    load,
+    search_dirs,
+)
 from layered_swim.control.steering import SteeringGains
 from layered_swim.geometry import ease
 from layered_swim.state import JointLayout, Start
@@ -236,7 +246,8 @@ def _keyed_table(keys: dict[str, JointKeys], base: np.ndarray, layout: JointLayo
         if joint_keys.mirror_of is not None:
             mirrored = keys.get(joint_keys.mirror_of)
             if mirrored is None or mirrored.mirror_of is not None:
-                raise ConfigError(f"{where}': mirror_of '{joint_keys.mirror_of}' must name a keyed joint that is not itself a mirror")
+                raise ConfigError(f"{where}': mirror_of '{joint_keys.mirror_of}' must name a keyed joint "
+                                  "that is not itself a mirror")
             if joint_keys.axis_keys():
                 raise ConfigError(f"{where}': a mirrored joint takes no keys of its own")
             source_keys = mirrored

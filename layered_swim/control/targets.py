@@ -22,8 +22,18 @@ from typing import Any, Literal, Protocol, runtime_checkable
 import numpy as np
 from pydantic import Field
 
-from layered_swim.config import (SHIPPED_DIR, ConfigError, Coordinate_m, Strict, available_files, between, file_path,
-                                 load_yaml, parse, search_dirs)
+from layered_swim.config import (
+    SHIPPED_DIR,
+    ConfigError,
+    Coordinate_m,
+    Strict,
+    available_files,
+    between,
+    file_path,
+    load_yaml,
+    parse,
+    search_dirs,
+)
 
 TRAJECTORIES_DIR = SHIPPED_DIR / "trajectories"     # the top-level trajectories/ in a checkout
 CURVE_SAMPLES = 4096          # samples per closed curve (figure eight, circle)

@@ -2,8 +2,7 @@
 from importlib.util import find_spec
 
 from layered_swim.config import ConfigError
-from layered_swim.fluid.backend import (BACKENDS, FluidBackend, FluidError, FluidWrenches, make_fluid,
-                                        register_backend)
+from layered_swim.fluid.backend import BACKENDS, FluidBackend, FluidError, FluidWrenches, make_fluid, register_backend
 from layered_swim.fluid.thin_plate import PlateFluid
 
 SPH_INSTALL = "pip install -e '.[sph]'"

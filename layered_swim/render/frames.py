@@ -1,6 +1,6 @@
 """Writes rendered frames: an MP4 through imageio-ffmpeg (the ``video`` extra) when it is
-installed, otherwise numbered PNG frames; screenshots as PNG. Encoding runs on a background
-thread so recording does not stall the window."""
+installed, otherwise numbered PNG frames; screenshots and stills as PNG. Encoding runs on a
+background thread so recording does not stall the window."""
 from __future__ import annotations
 
 import os
@@ -27,9 +27,35 @@ def mp4_encoder_available() -> bool:
 
 
 def save_png(pixels: np.ndarray, path: Path) -> Path:
+    """Written under a temporary name and moved into place: never half a picture."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    Image.fromarray(pixels).save(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp.png")
+    try:
+        Image.fromarray(pixels).save(tmp)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
     return path
+
+
+def check_png_out(path: Path, overwrite: bool) -> None:
+    """Before a still is drawn: ``path`` may take it (an existing file only with ``overwrite``)."""
+    if path.is_symlink():
+        raise ConfigError(f"{path}: is a symbolic link; give the real path, if it is meant")
+    if path.is_dir():
+        raise ConfigError(f"{path}: is a folder; choose another --out")
+    if path.exists() and not overwrite:
+        raise ConfigError(f"{path}: exists; choose another --out or add --overwrite to replace it")
+    _check_folder_of(path)
+
+
+def _check_folder_of(path: Path) -> None:
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise ConfigError(f"{path.parent}: cannot create it ({err.strerror})") from None
+    if not os.access(path.parent, os.W_OK):
+        raise ConfigError(f"{path.parent}: cannot write there")
 
 
 class FrameWriter:
@@ -105,12 +131,7 @@ class FrameWriter:
                 for f in self.path.iterdir()):
             raise ConfigError(f"{self.path}: holds files that are not rendered frames; refusing to touch them, "
                               "choose another --out")
-        try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-        except OSError as err:
-            raise ConfigError(f"{self.path.parent}: cannot create it ({err.strerror})") from None
-        if not os.access(self.path.parent, os.W_OK):
-            raise ConfigError(f"{self.path.parent}: cannot write there")
+        _check_folder_of(self.path)
 
     def _finish(self) -> None:
         self._queue.put(None)

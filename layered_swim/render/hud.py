@@ -29,7 +29,7 @@ def hud_lines(session: SwimSession, fps: float, recording: str = "") -> list[str
         f"time        {s.sim.time_s:6.1f} s    {clock}    {fps:.0f} FPS",
     ]
     if s.policy is not None:
-        lines.insert(4, f"policy      learned residual on the {s.policy.env['reference']} controller")
+        lines.insert(4, f"policy      learned residual on the {s.policy.env.reference} controller")
     if recording:
         lines.append(f"REC         {recording}")
     if s.message:

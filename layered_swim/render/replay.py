@@ -6,10 +6,10 @@ from pathlib import Path
 
 import numpy as np
 
-from layered_swim.render.scene import Scene
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, check_regular_file, load_json
 from layered_swim.recorder import MAX_LOG_BYTES, UNREADABLE_ARCHIVE, read_log
+from layered_swim.render.scene import Scene
 
 TRAIL_SECONDS = 60.0
 

@@ -19,12 +19,20 @@ TRAIL_COLOR = (1.0, 1.0, 1.0, 1.0)
 PATH_COLOR = (1.0, 0.55, 0.9, 1.0)
 FORCE_COLOR = (0.1, 1.0, 0.3, 1.0)
 CURRENT_COLOR = (0.2, 0.95, 1.0, 1.0)
-GRID_COLOR = (0.05, 0.2, 0.35, 1.0)
-WATER_COLOR = (0.08, 0.42, 0.68, 0.5)
+FLOW_COLOR = (1.0, 0.6, 0.1, 1.0)           # the water velocity at the segments: orange on blue
+GRID_COLOR = (0.12, 0.22, 0.3, 1.0)
+FLOOR_COLOR = (0.42, 0.5, 0.52, 1.0)
+SURFACE_COLOR = (0.1, 0.45, 0.66, 0.3)      # seen from above; alpha: how much it veils what is under it
+DEEP_COLOR = (0.04, 0.3, 0.45, 1.0)         # what water turns everything toward with distance
 SKY_COLOR = (0.66, 0.8, 0.92, 1.0)
 
 FORCE_SCALE_M_PER_N = 0.004     # a 100 N fluid force draws as a 0.4 m arrow
 CURRENT_SCALE_M_PER_M_S = 2.0
+FLOW_SCALE_M_PER_M_S = 0.8      # the flow lattice's arrows: 0.5 m/s is 0.4 m, well inside a cell
+FLOW_SPACING_M = 1.0
+FLOW_HALF_POINTS = 3
+FLOW_DEPTHS_M = (0.3, 1.0)
+STILL_MARK_M = 0.04             # half a still-water cross at a lattice point
 MARKER_SIZE_M = 0.22
 GRID_DEPTH_M = 3.0               # the open-water grid lies this far below the surface
 GRID_SPACING_M = 2.0
@@ -63,6 +71,7 @@ class Scene:
     current_m_s: np.ndarray | None = None
     particles_m: np.ndarray | None = None        # (k, 3) water particles (the SPH backend)
     particle_speed_m_s: np.ndarray | None = None  # (k,)
+    flow_m_s: np.ndarray | None = None            # (n, 3) water velocity at each segment, as the fluid found it
 
     @property
     def centre_of_segments_m(self) -> np.ndarray:
@@ -132,6 +141,31 @@ def grid_lines(centre_m: np.ndarray, z_m: float = -GRID_DEPTH_M, spacing_m: floa
     along_x = [((cx - extent, cy + o, z_m), (cx + extent, cy + o, z_m)) for o in offsets]
     along_y = [((cx + o, cy - extent, z_m), (cx + o, cy + extent, z_m)) for o in offsets]
     return np.array(along_x + along_y, dtype=float).reshape(-1, 3)
+
+
+def square(centre_m: np.ndarray, half_m: float, z_m: float) -> np.ndarray:
+    """Two triangles (6, 3) of a level square around ``centre_m``'s x, y at height ``z_m``."""
+    cx, cy = centre_m[0], centre_m[1]
+    corners = np.array([(cx - half_m, cy - half_m), (cx + half_m, cy - half_m), (cx + half_m, cy + half_m),
+                        (cx - half_m, cy + half_m)])[[0, 1, 2, 0, 2, 3]]
+    return np.column_stack([corners, np.full(6, z_m)])
+
+
+def flow_lattice(centre_m: np.ndarray, spacing_m: float = FLOW_SPACING_M, half_points: int = FLOW_HALF_POINTS,
+                 depths_m=FLOW_DEPTHS_M) -> np.ndarray:
+    """Points (k, 3) around the swimmer where the current is drawn, snapped to world multiples of
+    the spacing like the grid, so the arrows stand still in the water as the swimmer passes."""
+    cx, cy = np.round(np.asarray(centre_m[:2]) / spacing_m) * spacing_m
+    offsets = np.arange(-half_points, half_points + 1) * spacing_m
+    x, y, z = np.meshgrid(cx + offsets, cy + offsets, -np.asarray(depths_m, float), indexing="ij")
+    return np.column_stack([x.ravel(), y.ravel(), z.ravel()])
+
+
+def cross_lines(points_m: np.ndarray, half_m: float = STILL_MARK_M) -> np.ndarray:
+    """Line-segment endpoints (k * 4, 3) of a small level cross at each point: still water."""
+    points_m = np.atleast_2d(points_m)
+    dx, dy = np.array([half_m, 0.0, 0.0]), np.array([0.0, half_m, 0.0])
+    return np.stack([points_m - dx, points_m + dx, points_m - dy, points_m + dy], axis=1).reshape(-1, 3)
 
 
 SPEED_COLOR_MAX_M_S = 1.5     # water at this speed or faster is drawn white

@@ -11,16 +11,15 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from layered_swim.render.scene import Scene
+from layered_swim.control.auto import AUTO
 from layered_swim.control.calibration import CalibrationError
 from layered_swim.control.layered import Layers
 from layered_swim.control.steering import attitude_of
-from layered_swim.control.auto import AUTO
 from layered_swim.control.stroke import available_strokes, stroke_path
 from layered_swim.control.targets import MovableTarget, TrajectoryTarget, load_trajectory
 from layered_swim.episode import Episode
-from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S
-from layered_swim.fluid.medium import water
+from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S, water
+from layered_swim.render.scene import Scene
 from layered_swim.sim.simulation import PHYSICS_HZ, SimulationDiverged
 from layered_swim.tasks import FollowTarget
 
@@ -82,7 +81,7 @@ class SwimSession:
             stroke_path(stroke)                      # unknown stroke: one-line error before anything opens
         if stroke not in self.strokes:
             self.strokes.append(stroke)              # a stroke file given by path
-        # A learned residual (rl.policy.Policy) drives its own stroke on its own reference controller.
+        # A learned residual (rl.policy.ResidualPolicy) drives its own stroke on its own reference controller.
         self.policy = policy
         if policy is not None:
             policy.check_stroke(stroke)
@@ -150,8 +149,8 @@ class SwimSession:
             # A stroke without a usable table still swims, with the rules but no steering.
             self.cycle_available = False
             self.message = f"per-cycle steering off: {err}"
-            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz, layers=Layers(cycle=False),
-                              backend=self.backend, fluid_settings=self.fluid_settings)
+            episode = Episode(stroke, task, medium=self._medium(), physics_hz=self.physics_hz,
+                              layers=Layers(cycle=False), backend=self.backend, fluid_settings=self.fluid_settings)
         return episode
 
     def _apply_layers(self) -> None:
@@ -245,7 +244,8 @@ class SwimSession:
         if self.diverged:
             return
         try:
-            self.episode.run(steps=steps, observers=[self._driver, self._after_step] if self._driver else [self._after_step])
+            self.episode.run(steps=steps,
+                             observers=[self._driver, self._after_step] if self._driver else [self._after_step])
         except SimulationDiverged as err:
             self.diverged, self.divergence = True, str(err)
             self.message = f"{err}; press R to reset"
@@ -303,7 +303,8 @@ class SwimSession:
         water = self.sim.fluid.particles()
         return Scene(body.segment_names, body.half_extents_m, state.pos_m, state.quat_xyzw, self.target_m,
                      self.trajectory_path_m if self.target.scripted else None, np.array(self.trail),
-                     self.sim.fluid_force_n, self.current_m_s, *(water or (None, None)))
+                     self.sim.fluid_force_n, self.current_m_s, *(water or (None, None)),
+                     flow_m_s=self.sim.fluid_now.flow_m_s)
 
     def close(self) -> None:
         self.episode.close()

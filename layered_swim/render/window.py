@@ -44,18 +44,23 @@ def _stroke_by_number(window: "SwimWindow", symbol: int) -> None:
 
 BINDINGS = (
     Binding("H", "show or hide this help", (key.H,), lambda w, s: w.toggle_help()),
-    Binding("1-9", "choose the stroke by number (listed below)", tuple(key._1 + i for i in range(9)), _stroke_by_number),
+    Binding("1-9", "choose the stroke by number (listed below)", tuple(key._1 + i for i in range(9)),
+            _stroke_by_number),
     Binding("Tab", "next stroke", (key.TAB,), lambda w, s: w.session.next_stroke()),
     Binding("C", "per-cycle steering layer on/off", (key.C,), lambda w, s: w.session.toggle_layer("cycle")),
     Binding("P", "palm-orientation rule on/off", (key.P,), lambda w, s: w.session.toggle_layer("palm")),
     Binding("A", "arm-reach rule on/off", (key.A,), lambda w, s: w.session.toggle_layer("reach")),
-    Binding("U", "next current preset (none, 0.3 m/s cross, 0.5 m/s head-on)", (key.U,), lambda w, s: w.session.next_current()),
+    Binding("U", "next current preset (none, 0.3 m/s cross, 0.5 m/s head-on)", (key.U,),
+            lambda w, s: w.session.next_current()),
     Binding("D", "next fluid (fresh water, seawater, light, dense)", (key.D,), lambda w, s: w.session.next_density()),
     Binding("Space", "pause / resume", (key.SPACE,), lambda w, s: w.toggle_pause()),
     Binding("N", "single step (1/60 s) while paused", (key.N,), lambda w, s: w.single_step()),
     Binding("R", "reset the swim", (key.R,), lambda w, s: w.session.reset()),
     Binding("M", "slow motion (quarter speed) on/off", (key.M,), lambda w, s: w.toggle_slow_motion()),
     Binding("F", "fluid-force arrows on/off", (key.F,), lambda w, s: w.toggle_forces()),
+    Binding("W", "water flow arrows on/off (the current around, the water at each segment)", (key.W,),
+            lambda w, s: w.toggle_flow()),
+    Binding("K", "next camera (follow, side at the surface, underwater)", (key.K,), lambda w, s: w.next_camera()),
     Binding("T", "back to the trajectory's target (trajectory mode)", (key.T,), lambda w, s: w.back_to_trajectory()),
     Binding("PgUp/PgDn", "target shallower / deeper (or Shift + wheel)", (key.PAGEUP, key.PAGEDOWN),
             lambda w, s: w.session.change_target_depth(-DEPTH_STEP_M if s == key.PAGEUP else DEPTH_STEP_M)),
@@ -80,6 +85,7 @@ class SwimWindow(pyglet.window.Window):
         self.push_handlers(self.keys)
         self.show_help = False
         self.show_forces = False
+        self.show_flow = False
         self._screenshot_pending = False
         self.recorder: FrameWriter | None = None
         self._last_video_frame_s = -math.inf
@@ -123,7 +129,8 @@ class SwimWindow(pyglet.window.Window):
 
     def draw_frame(self) -> None:
         width, height = self.get_framebuffer_size()
-        self.renderer.draw(self.session.scene(), self.camera, width, height, show_forces=self.show_forces)
+        self.renderer.draw(self.session.scene(), self.camera, width, height, show_forces=self.show_forces,
+                           show_flow=self.show_flow, time_s=self.session.sim.time_s)
         self._hud_batch.draw()
         if self.show_help:
             self._help_batch.draw()
@@ -159,7 +166,8 @@ class SwimWindow(pyglet.window.Window):
         self._hud.text = "\n".join(hud_lines(self.session, self.fps, recording))
         self._hud.y = self.height - 10
         self._hud_box.x, self._hud_box.y = 4, self.height - self._hud.content_height - 18
-        self._hud_box.width, self._hud_box.height = min(self.width - 8, self._hud.content_width + 16), self._hud.content_height + 14
+        self._hud_box.width, self._hud_box.height = (min(self.width - 8, self._hud.content_width + 16),
+                                                     self._hud.content_height + 14)
 
     def help_text(self) -> str:
         strokes = ", ".join(f"{i + 1} {name}" for i, name in enumerate(self.session.strokes[:9]))
@@ -178,6 +186,12 @@ class SwimWindow(pyglet.window.Window):
 
     def toggle_forces(self) -> None:
         self.show_forces = not self.show_forces
+
+    def toggle_flow(self) -> None:
+        self.show_flow = not self.show_flow
+
+    def next_camera(self) -> None:
+        self.session.message = f"camera: {self.camera.next_view()}"
 
     def single_step(self) -> None:
         if self.session.paused:

@@ -15,6 +15,7 @@ try:
 except ImportError:           # one line for the user, not a traceback
     raise ConfigError(f"the RL environment needs the [rl] extra: {RL_INSTALL}") from None
 
-for _id, _stroke in (("layered_swim/FrontCrawlGoal-v0", "front_crawl"), ("layered_swim/BreaststrokeGoal-v0", "breaststroke")):
+for _id, _stroke in (("layered_swim/FrontCrawlGoal-v0", "front_crawl"),
+                     ("layered_swim/BreaststrokeGoal-v0", "breaststroke")):
     if _id not in gymnasium.registry:
         gymnasium.register(id=_id, entry_point="layered_swim.rl.env:SwimGoalEnv", kwargs={"stroke": _stroke})

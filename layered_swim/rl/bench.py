@@ -40,7 +40,8 @@ def bench_env(seconds: float = 10.0, env_state: str = "SmoothFT", hidden: tuple[
     t = env.timing
     physics = t["physics_s"]
     env_added = t["observation_s"] + t["reward_s"]
-    return {"env_steps": steps, "policy_hz": round(1.0 / env.dt_s), "physics_steps_per_env_step": env.physics_per_action,
+    return {"env_steps": steps, "policy_hz": round(1.0 / env.dt_s),
+            "physics_steps_per_env_step": env.physics_per_action,
             "env_steps_per_s_per_core": round(steps / wall_s, 1), "wall_s": round(wall_s, 2),
             "share_physics": round(physics / wall_s, 3), "share_observation": round(t["observation_s"] / wall_s, 3),
             "share_reward": round(t["reward_s"] / wall_s, 3), "share_policy": round(policy_s / wall_s, 3),

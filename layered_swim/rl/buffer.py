@@ -11,7 +11,9 @@ When the buffer is over capacity, episodes are evicted one at a time, each drawn
 
 P_FIFO is 1 for the oldest episode; P_age and P_reward are normalised over the buffer. Early on
 (T near 1) the oldest goes; later, old and middling-return episodes go, keeping the best and the
-worst, which teach the most.
+worst, which teach the most. The settings (``e_mid``, ``k``, ``w_age``, ``w_reward``, ``sigma``)
+and the rule (``eviction``: ``fifo`` or ``progevict``) are the training YAML's ``buffer`` section,
+a ``BufferSpec``.
 """
 from __future__ import annotations
 
@@ -20,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from layered_swim.config import ConfigError
+from layered_swim.rl.config import BufferSpec
 
 
 @dataclass
@@ -47,27 +49,13 @@ class EpisodeData:
         return float(self.rewards.sum())
 
 
-@dataclass(frozen=True)
-class EvictionSettings:
-    e_mid: float = 30.0          # the epoch where FIFO and the heuristic weigh the same
-    k: float = 5.0               # how many epochs the hand-over takes (its scale)
-    w_age: float = 0.5
-    w_reward: float = 0.5
-    sigma: float = 0.5
-
-    def __post_init__(self):
-        if not (self.k > 0 and self.sigma > 0 and self.w_age >= 0 and self.w_reward >= 0
-                and self.w_age + self.w_reward > 0 and math.isfinite(self.e_mid)):
-            raise ConfigError(f"eviction settings need k > 0, sigma > 0 and non-negative weights, got {self}")
-
-
-def transition(epoch: float, s: EvictionSettings) -> float:
+def transition(epoch: float, s: BufferSpec) -> float:
     """Eq. 17: T(e), near 1 early (FIFO), near 0 late (the heuristic)."""
     x = (epoch - s.e_mid) / s.k
     return 0.0 if x > 700 else 1.0 / (1.0 + math.exp(x))
 
 
-def eviction_probabilities(collected_epochs, returns, current_epoch: int, s: EvictionSettings) -> np.ndarray:
+def eviction_probabilities(collected_epochs, returns, current_epoch: int, s: BufferSpec) -> np.ndarray:
     """Eqs. 16-20 for every episode in the buffer (they sum to 1)."""
     epochs = np.asarray(collected_epochs, dtype=float)
     n = len(epochs)
@@ -85,17 +73,11 @@ def eviction_probabilities(collected_epochs, returns, current_epoch: int, s: Evi
 
 
 class EpisodeBuffer:
-    """Up to ``capacity`` episodes; ``add`` inserts new ones and evicts by ``policy`` (``fifo`` or
-    ``progevict``) with ``rng``."""
+    """Up to ``spec.capacity_episodes`` episodes; ``add`` inserts new ones and evicts by
+    ``spec.eviction`` (``fifo`` or ``progevict``) with ``rng``."""
 
-    POLICIES = ("fifo", "progevict")
-
-    def __init__(self, capacity: int, policy: str = "progevict", settings: EvictionSettings = EvictionSettings()):
-        if policy not in self.POLICIES:
-            raise ConfigError(f"buffer must be one of {', '.join(self.POLICIES)}, got {policy!r}")
-        if not (isinstance(capacity, int) and capacity >= 1):
-            raise ConfigError(f"buffer capacity must be a positive integer, got {capacity!r}")
-        self.capacity, self.policy, self.settings = capacity, policy, settings
+    def __init__(self, spec: BufferSpec = BufferSpec()):
+        self.spec, self.capacity = spec, spec.capacity_episodes
         self.episodes: list[EpisodeData] = []
 
     def add(self, episodes: list[EpisodeData], epoch: int, rng: np.random.Generator) -> int:
@@ -106,11 +88,11 @@ class EpisodeBuffer:
         self.episodes.extend(episodes)
         evicted = 0
         while len(self.episodes) > self.capacity:
-            if self.policy == "fifo":
+            if self.spec.eviction == "fifo":
                 victim = 0
             else:
                 p = eviction_probabilities([e.epoch for e in self.episodes],
-                                           [e.episode_return for e in self.episodes], epoch, self.settings)
+                                           [e.episode_return for e in self.episodes], epoch, self.spec)
                 victim = int(rng.choice(len(p), p=p))
             del self.episodes[victim]
             evicted += 1

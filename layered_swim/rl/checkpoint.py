@@ -12,7 +12,9 @@ from layered_swim.config import ConfigError
 from layered_swim.rl.buffer import EpisodeData
 from layered_swim.rl.checks import check_keys, check_tensors, is_count, read_weights
 
-CHECKPOINT_FORMAT = 2             # 2: the buffer's arrays as tensors, so torch's safe unpickler reads it all
+# 2: the buffer's arrays as tensors, so torch's safe unpickler reads it all; 3: the spec's buffer.policy
+# renamed buffer.eviction.
+CHECKPOINT_FORMAT = 3
 CHECKPOINT_KEYS = ("format", "spec", "model", "optimiser", "normaliser", "epoch", "samples", "wall_s", "rng",
                    "generator", "buffer")
 MAX_CHECKPOINT_BYTES = 4 * 2**30  # 64 buffered episodes are tens of MB; the largest buffer allowed nears this
@@ -99,7 +101,8 @@ def buffer_episodes(value, n_obs: int, n_act: int, capacity: int, epoch: int, so
         budget -= sum(a.numel() * a.element_size() for a in arrays)
         if budget < 0:
             raise ConfigError(f"{source}: the buffer's arrays add up to more than a checkpoint may hold")
-        steps = arrays[3].shape[0] if arrays[3].dim() == 1 else 0
+        rewards = arrays[EPISODE_ARRAYS.index("rewards")]
+        steps = rewards.shape[0] if rewards.dim() == 1 else 0
         shapes = [(steps, n_obs), (steps, n_act), (steps,), (steps,), (n_obs,)]
         if steps < 1 or [tuple(a.shape) for a in arrays] != shapes:
             raise ConfigError(f"{source}: buffer episode {k}: expected T >= 1 steps of {n_obs} observations, "

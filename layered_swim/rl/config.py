@@ -1,6 +1,10 @@
 """The training configuration: a YAML file people edit (``layered_swim/rl/front_crawl.yaml`` is
 the shipped one), checked field by field, plus ``--set key=value`` overrides (dotted keys,
-YAML values: ``--set ppo.learning_rate=1e-4``)."""
+YAML values: ``--set ppo.learning_rate=1e-4``).
+
+Each section's type is the one the code uses, validated once here: ``EnvSpec`` (a policy file's
+``env`` too, ``ResidualPolicy.env``), ``RewardSpec`` (the reward's weights, ``reward.py``),
+``PpoSpec`` (``ppo.update``) and ``BufferSpec`` (``EpisodeBuffer``)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -27,6 +31,9 @@ Hidden = Annotated[tuple[count(1, MAX_HIDDEN_WIDTH), ...], Field(min_length=1, m
 
 
 class EnvSpec(Strict):
+    """The environment a residual trains in (``SwimGoalEnv``'s arguments but the reward's weights
+    and what a run changes: backend, current)."""
+
     stroke: str = "front_crawl"
     pool: Literal["small", "large"] = "small"
     reference: Literal["basic", "layered"] = "basic"
@@ -44,20 +51,24 @@ class EnvSpec(Strict):
 
 
 class RewardSpec(Strict):
-    forward_per_m: between(0.0, 1000.0) = 5.0
-    deviation_per_m: between(0.0, 1000.0) = 10.0
-    heading_per_rad: between(0.0, 1000.0) = 2.0
-    roll_per_rad: between(0.0, 1000.0) = 2.0
-    accel_s2_per_rad: between(0.0, 10.0) = 0.01
-    accel_weight: between(0.0, 10.0) = 0.1
+    """The reward's weights (SWIM eqs. 9-15, ``reward.py``)."""
+
+    forward_per_m: between(0.0, 1000.0) = 5.0           # a_p
+    deviation_per_m: between(0.0, 1000.0) = 10.0        # a_a
+    heading_per_rad: between(0.0, 1000.0) = 2.0         # a_h
+    roll_per_rad: between(0.0, 1000.0) = 2.0            # a_r
+    accel_s2_per_rad: between(0.0, 10.0) = 0.01         # a_s
+    accel_weight: between(0.0, 10.0) = 0.1              # w_accel
 
 
 class PpoSpec(Strict):
-    gamma: between(0.0, 1.0) = 0.97
+    """PPO's settings (``ppo.update``) and the network's shape (``hidden``, ``init_log_std``)."""
+
+    gamma: between(0.0, 1.0) = 0.97                     # 4 s horizon at 30 Hz: rewards ~1 s ahead still count
     lam: between(0.0, 1.0) = 0.95
     clip: between(0.0, 1.0, above=True) = 0.2
     learning_rate: between(0.0, 1.0, above=True) = 3e-4
-    epochs: count(1, 1000) = 5
+    epochs: count(1, 1000) = 5                          # passes over the buffer per update
     minibatch: count(1, 1_000_000) = 512
     value_coef: between(0.0, 100.0) = 0.5
     entropy_coef: between(0.0, 1.0) = 0.0
@@ -66,14 +77,27 @@ class PpoSpec(Strict):
     init_log_std: between(-10.0, 2.0) = -1.0
 
 
+EVICTIONS = ("fifo", "progevict")
+
+
 class BufferSpec(Strict):
-    policy: Literal["fifo", "progevict"] = "progevict"
+    """The episode buffer (``EpisodeBuffer``): its size, its eviction rule and ProgEvict's settings
+    (SWIM eqs. 16-20; ``fifo`` uses none of them)."""
+
+    eviction: Literal[EVICTIONS] = "progevict"
     capacity_episodes: count(1, 100_000) = 64
-    e_mid: between(-1e6, 1e6) = 30.0
-    k: between(0.0, 1e6, above=True) = 5.0
+    e_mid: between(-1e6, 1e6) = 30.0                    # the epoch where FIFO and the heuristic weigh the same
+    k: between(0.0, 1e6, above=True) = 5.0              # how many epochs the hand-over takes (its scale)
     w_age: between(0.0, 1.0) = 0.5
     w_reward: between(0.0, 1.0) = 0.5
     sigma: between(0.0, 10.0, above=True) = 0.5
+
+    @model_validator(mode="before")
+    @classmethod
+    def _renamed(cls, data):
+        if isinstance(data, dict) and "policy" in data:
+            raise ValueError(f"policy is now called eviction ({' or '.join(EVICTIONS)})")
+        return data
 
     @model_validator(mode="after")
     def _some_weight(self) -> "BufferSpec":

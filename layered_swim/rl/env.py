@@ -19,29 +19,40 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any
+from typing import Any, NamedTuple
 
 import gymnasium as gym
 import numpy as np
 
-from layered_swim.config import ConfigError
+from layered_swim.config import ConfigError, parse
 from layered_swim.control.residual import ResidualController
 from layered_swim.control.steering import attitude_of
 from layered_swim.fluid import FluidError
 from layered_swim.rl import observation as obs
-from layered_swim.rl.reward import BODY_POINT_WEIGHTS, RewardWeights, reward_parts
+from layered_swim.rl.config import RewardSpec
+from layered_swim.rl.reward import BODY_POINT_WEIGHTS, reward_parts
 from layered_swim.runs import goal_episode
-from layered_swim.spec import SwimSpec, sph_fields
 from layered_swim.sim.simulation import SimulationDiverged
+from layered_swim.spec import SwimSpec, sph_fields
+from layered_swim.state import BodyState
 from layered_swim.tasks import swim_benchmark as bench
 
 REFERENCES = {"basic": "basic", "layered": "basic,cycle,rules"}
 
 
+class Observed(NamedTuple):
+    """What ``PolicyInput`` read at its last observation that the reward needs."""
+
+    state: BodyState
+    roll_rad: float                 # the shoulder roll
+    goal_yaws_rad: np.ndarray       # the intermediate goals' bearings off the heading
+    joint_rates: np.ndarray         # every joint's rate (a copy)
+
+
 class PolicyInput:
     """The observation of an episode now, for any task: the environment gives it the goal
     task's intermediate goals, a policy driving another task (``policy.ResidualDriver``) the
-    target's positions ahead. Keeps what the reward needs (``now``)."""
+    target's positions ahead. Keeps what the reward needs (``now``, an ``Observed``)."""
 
     def __init__(self, episode, env_state: str):
         sim = episode.sim
@@ -51,7 +62,7 @@ class PolicyInput:
         self.layout = obs.layout_for(len(positions), len(rates), len(episode.body.segment_names), env_state)
         self._links = [episode.body.index(name) for name in obs.TRACKED_LINKS]
         self._smoothed = None
-        self.now = None
+        self.now: Observed | None = None
 
     def reset(self) -> None:
         self._smoothed = None
@@ -73,7 +84,8 @@ class PolicyInput:
                                                      state.linvel_m_s[:1], state.angvel_rad_s[:1]]), heading)
         n = len(self._links)
         parts = {
-            "root_height": root[2], "root_roll": att.roll_rad, "root_linvel": links[2 * n], "root_angvel": links[2 * n + 1],
+            "root_height": root[2], "root_roll": att.roll_rad, "root_linvel": links[2 * n],
+            "root_angvel": links[2 * n + 1],
             "link_pos": links[:n].ravel(), "link_vel": links[n:2 * n].ravel(),
             "joint_pos": sim.world.joint_positions(), "joint_vel": rates,
             "phase": obs.phase_encoding(sim.controller.phase(sim.time_s)), "goals": goals.ravel(), "env": env,
@@ -81,7 +93,7 @@ class PolicyInput:
         vector = np.empty(layout.size, np.float32)
         for name, where in layout.slices.items():
             vector[where] = parts[name]
-        self.now = (state, att.roll_rad, yaws, rates.copy())
+        self.now = Observed(state, att.roll_rad, yaws, rates.copy())
         return vector
 
 
@@ -90,9 +102,11 @@ class SwimGoalEnv(gym.Env):
 
     def __init__(self, stroke: str = "front_crawl", pool: str = "small", reference: str = "basic",
                  env_state: str = "SmoothFT", policy_hz: int = 30, action_scale_rad: float = 0.2,
-                 reward_weights: RewardWeights = RewardWeights(), backend: str = "plate", fluid_settings=None,
+                 reward_weights: RewardSpec | dict = RewardSpec(), backend: str = "plate", fluid_settings=None,
                  current_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0), goal: int | None = None,
                  start_jitter: bool = False):
+        if isinstance(reward_weights, dict):     # gym.make's keyword arguments: checked like the YAML's reward section
+            reward_weights = parse(RewardSpec, reward_weights, "the environment's reward_weights")
         if reference not in REFERENCES:
             raise ConfigError(f"reference must be one of {', '.join(REFERENCES)}, got {reference!r}")
         if not (isinstance(action_scale_rad, (int, float)) and 0.0 < action_scale_rad <= 1.0):
@@ -134,7 +148,7 @@ class SwimGoalEnv(gym.Env):
         self.input.reset()
         sim = self.episode.sim
         self._last_obs = self._observe(sim.fluid_now.force_n, sim.fluid_now.torque_nm)
-        self._rates = self.input.now[3]
+        self._rates = self.input.now.joint_rates
         return self._last_obs.copy(), {"goal": goal, "goal_m": list(self.episode.task.goal.goal_m)}
 
     def step(self, action):
@@ -157,7 +171,7 @@ class SwimGoalEnv(gym.Env):
         torque /= self.physics_per_action
         self._last_obs = observation = self._observe(force, torque)
         rewarded = time.perf_counter()
-        rates = self.input.now[3]
+        rates = self.input.now.joint_rates
         parts = self._reward((rates - self._rates) / self.dt_s)
         self._rates = rates
         done = time.perf_counter()
@@ -182,11 +196,13 @@ class SwimGoalEnv(gym.Env):
         return self.input(force_n, torque_nm, goals)
 
     def _reward(self, joint_accel: np.ndarray) -> dict:
-        state, roll, yaws, _ = self.input.now
+        now = self.input.now
+        state = now.state
         task = self.episode.task.goal
         body_point = sum(w * state.pos_m[k] for k, w in self._body_point.items())
         return reward_parts(bench.goal_position(task, state.time_s), state.pos_m[0], body_point, task.start_m,
-                            task.direction, yaws, roll, self.roll_tolerance_rad, joint_accel, self.reward_weights)
+                            task.direction, now.goal_yaws_rad, now.roll_rad, self.roll_tolerance_rad, joint_accel,
+                            self.reward_weights)
 
     def _failure(self, com_m: np.ndarray) -> str | None:
         x0, x1 = self.pool.x_range_m

@@ -91,7 +91,8 @@ def env_features(env_state: str, force_n: np.ndarray, torque_nm: np.ndarray, pos
     if env_state == "TotalFT":
         total_torque = torque_nm.sum(axis=0) + np.cross(pos_m - com_m, force_n).sum(axis=0)
         return to_heading_frame(np.stack([force_n.sum(axis=0), total_torque]), heading_rad).ravel(), None
-    raw = np.concatenate([to_heading_frame(force_n, heading_rad), to_heading_frame(torque_nm, heading_rad)], axis=1).ravel()
+    raw = np.concatenate([to_heading_frame(force_n, heading_rad), to_heading_frame(torque_nm, heading_rad)],
+                         axis=1).ravel()
     if env_state == "RawFT":
         return raw, None
     now = squash(raw)

@@ -1,6 +1,7 @@
-"""A trained residual policy as a file: the actor, its observation normaliser and the
-environment it was trained in (``policy.pt``, small, loadable without the trainer's state);
-running it on SWIM's goal task (``evaluate_goals``) and inside any other episode
+"""A trained residual policy (``ResidualPolicy``) as a file: the actor, its observation
+normaliser and the environment it was trained in (``policy.pt``, small, loadable without the
+trainer's state; its ``env`` and ``reward`` sections are an ``EnvSpec`` and a ``RewardSpec`` in
+memory); running it on SWIM's goal task (``evaluate_goals``) and inside any other episode
 (``ResidualDriver``: trajectories, the app's mouse point)."""
 from __future__ import annotations
 
@@ -13,8 +14,7 @@ import torch
 from layered_swim.config import ConfigError, parse
 from layered_swim.rl.checks import check_keys, check_normaliser, check_tensors, is_count, is_number, read_weights
 from layered_swim.rl.config import MAX_HIDDEN_LAYERS, MAX_HIDDEN_WIDTH, EnvSpec, RewardSpec
-from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, Normaliser
-from layered_swim.rl.reward import RewardWeights
+from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, ModelArgs, Normaliser
 from layered_swim.tasks.goal import GOAL_METRICS
 from layered_swim.tasks.swim_benchmark import goal_leads_s
 
@@ -25,7 +25,7 @@ MAX_IO_SIZE = 10_000                # observations or actions (the body gives 25
 
 
 class Steering(NamedTuple):
-    """A learned residual in charge of an episode (``Policy.steering``)."""
+    """A learned residual in charge of an episode (``ResidualPolicy.steering``)."""
 
     layers: object          # the reference controller's layers (control.layered.Layers)
     wrap: Callable          # Episode's wrap: the residual's controller around the reference
@@ -33,18 +33,25 @@ class Steering(NamedTuple):
     summary: dict           # what a run's summary says of it
 
 
-class Policy:
-    def __init__(self, model: ActorCritic, normaliser: Normaliser, env: dict, reward: dict, model_args: tuple,
-                 source: str = "the policy"):
-        self.model, self.normaliser, self.env, self.reward, self.model_args = model, normaliser, env, reward, model_args
+class ResidualPolicy:
+    """The trained residual: the actor (``model``) and its observation ``normaliser``, and the
+    environment (``env``) and reward weights (``reward``) it was trained with."""
+
+    def __init__(self, model: ActorCritic, normaliser: Normaliser, env: EnvSpec, reward: RewardSpec,
+                 model_args: ModelArgs | tuple, source: str = "the policy"):
+        self.model, self.normaliser, self.env, self.reward = model, normaliser, env, reward
+        self.model_args = ModelArgs(*model_args)
         self.source = source          # what error messages call it: the file it came from
 
     def to_file(self) -> dict:
+        """The file's content: plain data and tensors (torch's safe unpickler reads it), the
+        specs as their sections' dicts."""
         return {"format": POLICY_FORMAT, "model_args": list(self.model_args), "model": self.model.state_dict(),
-                "normaliser": self.normaliser.state_dict(), "env": self.env, "reward": self.reward}
+                "normaliser": self.normaliser.state_dict(), "env": self.env.model_dump(),
+                "reward": self.reward.model_dump()}
 
     @classmethod
-    def load(cls, path: str | Path) -> "Policy":
+    def load(cls, path: str | Path) -> "ResidualPolicy":
         """A policy file, every part checked before use: a damaged or foreign one is one
         ConfigError naming it, never a traceback or a network of someone else's size."""
         if not Path(path).exists():
@@ -60,25 +67,25 @@ class Policy:
         if size > MAX_POLICY_BYTES:      # before allocating it: the file's shapes must match these
             raise ConfigError(f"{path}: model_args describe a {size}-byte network, more than a policy file may hold")
         weights = check_tensors(data["model"], like, "model", path)
-        scaling = check_normaliser(data["normaliser"], model_args[0], path)
+        scaling = check_normaliser(data["normaliser"], model_args.n_obs, path)
         model = ActorCritic(*model_args)
         model.load_state_dict(weights)
-        normaliser = Normaliser(model_args[0])
+        normaliser = Normaliser(model_args.n_obs)
         normaliser.load_state_dict(scaling)
         return cls(model, normaliser, env, reward, model_args, str(path))
 
     def check_stroke(self, stroke: str | None) -> None:
         """Refuse, in one line, to swim ``stroke`` (None: whichever it was trained for) with a
         policy trained for another."""
-        trained = self.env["stroke"]
+        trained = self.env.stroke
         if stroke is not None and stroke != trained:
             raise ConfigError(f"{self.source} was trained for {trained}, not {stroke}; add --stroke {trained}")
 
     def check_sizes(self, n_obs: int, n_act: int, where: str) -> None:
         """Refuse an episode whose observation or action differs from the network's (another body
         or observation variant): it would fail deep in a matrix product."""
-        if (n_obs, n_act) != tuple(self.model_args[:2]):
-            raise ConfigError(f"{self.source} expects {self.model_args[0]} observations and {self.model_args[1]} "
+        if (n_obs, n_act) != (self.model_args.n_obs, self.model_args.n_act):
+            raise ConfigError(f"{self.source} expects {self.model_args.n_obs} observations and {self.model_args.n_act} "
                               f"actions, {where} has {n_obs} and {n_act}")
 
     def steering(self, stroke: str | None = None) -> "Steering":
@@ -90,7 +97,7 @@ class Policy:
         from layered_swim.rl.env import REFERENCES
 
         self.check_stroke(stroke)
-        reference = self.env["reference"]
+        reference = self.env.reference
         return Steering(Layers.parse(REFERENCES[reference]), ResidualController,
                         lambda episode: ResidualDriver(self, episode), {"policy": self.source, "reference": reference})
 
@@ -99,7 +106,7 @@ class Policy:
         return env_arguments(self.env, self.reward, **changes)
 
 
-def model_arguments(value, source) -> tuple:
+def model_arguments(value, source) -> ModelArgs:
     """``ActorCritic``'s arguments (observations, actions, hidden widths, initial log std)
     within the training configuration's bounds."""
     if not (isinstance(value, (list, tuple)) and len(value) == 4):
@@ -113,28 +120,28 @@ def model_arguments(value, source) -> tuple:
                           f"in 1..{MAX_HIDDEN_WIDTH}")
     if not is_number(log_std):
         raise ConfigError(f"{source}: model_args log std must be a finite number")
-    return (n_obs, n_act, tuple(hidden), float(log_std))
+    return ModelArgs(n_obs, n_act, tuple(hidden), float(log_std))
 
 
-def section(spec, data, name: str, source) -> dict:
-    """A file's ``env`` or ``reward`` section, complete (a default filled in would change what
-    the policy was trained for) and checked by the training configuration's ``spec``."""
+def section(spec, data, name: str, source):
+    """A file's ``env`` or ``reward`` section as the training configuration's ``spec`` (EnvSpec,
+    RewardSpec), complete (a default filled in would change what the policy was trained for)."""
     check_keys(data, spec.model_fields, name, source)
-    return parse(spec, data, f"{source}: {name}").model_dump()
+    return parse(spec, data, f"{source}: {name}")
 
 
-def network_like(model_args: tuple) -> dict[str, torch.Tensor]:
+def network_like(model_args: ModelArgs) -> dict[str, torch.Tensor]:
     """The state of ``ActorCritic(*model_args)``: names, shapes and dtypes, nothing allocated."""
     with torch.device("meta"):
         return ActorCritic(*model_args).state_dict()
 
 
-def env_arguments(env: dict, reward: dict, **changes) -> dict:
+def env_arguments(env: EnvSpec, reward: RewardSpec, **changes) -> dict:
     """``SwimGoalEnv``'s keyword arguments from a config's ``env`` and ``reward`` sections."""
-    return {**env, "reward_weights": RewardWeights(**reward), **changes}
+    return {**env.model_dump(), "reward_weights": reward, **changes}
 
 
-def evaluate_goals(policy: Policy, seeds: int = 5, goals: list[int] | None = None, **env_changes) -> dict:
+def evaluate_goals(policy: ResidualPolicy, seeds: int = 5, goals: list[int] | None = None, **env_changes) -> dict:
     """The policy, deterministic, on each of ``goals`` (default: all the pool's) from ``seeds``
     starts (seed 0: SWIM's fixed start; the others jittered): Pos, Prog, Dev and Roll per run
     and their means."""
@@ -164,16 +171,16 @@ class ResidualDriver:
     the episode's state, the water's mean wrenches since its last action and four goals on the
     task's target ahead (SWIM eq. 2's leads along the target's own path), and sets the residual."""
 
-    def __init__(self, policy: Policy, episode):
+    def __init__(self, policy: ResidualPolicy, episode):
         from layered_swim.rl.env import PolicyInput
 
         self.policy, self.episode = policy, episode
         self.actor = ActorSnapshot(policy.model)
-        self.input = PolicyInput(episode, policy.env["env_state"])
+        self.input = PolicyInput(episode, policy.env.env_state)
         sim = episode.sim
         policy.check_sizes(self.input.layout.size, len(sim.layout.names), "this episode")
-        self.every = sim.config.physics_hz // int(policy.env["policy_hz"])
-        self.scale = float(policy.env["action_scale_rad"])
+        self.every = sim.config.physics_hz // policy.env.policy_hz
+        self.scale = float(policy.env.action_scale_rad)
         self.leads_s = goal_leads_s(episode.stroke.period_s)
         self._force = np.zeros_like(sim.fluid_now.force_n)
         self._torque = np.zeros_like(sim.fluid_now.torque_nm)

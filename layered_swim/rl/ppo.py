@@ -3,13 +3,14 @@ an observation normaliser, GAE, and the clipped update against the behaviour pol
 log-probabilities (the buffer may hold episodes from older policies: SWIM's ProgEvict)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import torch
 from torch import nn
 
 from layered_swim.rl.buffer import EpisodeData
+from layered_swim.rl.config import PpoSpec
 
 OBS_CLIP = 10.0
 
@@ -46,6 +47,15 @@ def _mlp(n_in: int, hidden: tuple[int, ...], n_out: int) -> nn.Sequential:
         width = h
     layers.append(nn.Linear(width, n_out))
     return nn.Sequential(*layers)
+
+
+class ModelArgs(NamedTuple):
+    """``ActorCritic``'s arguments (a policy file's ``model_args``, as a list)."""
+
+    n_obs: int
+    n_act: int
+    hidden: tuple[int, ...]
+    init_log_std: float
 
 
 class ActorCritic(nn.Module):
@@ -93,19 +103,6 @@ class ActorSnapshot:
         return action.astype(np.float32), float(self._log_norm - 0.5 * noise @ noise)
 
 
-@dataclass(frozen=True)
-class PpoSettings:
-    gamma: float = 0.97              # 4 s horizon at 30 Hz: rewards ~1 s ahead still count
-    lam: float = 0.95
-    clip: float = 0.2
-    learning_rate: float = 3e-4
-    epochs: int = 5                  # passes over the buffer per update
-    minibatch: int = 512
-    value_coef: float = 0.5
-    entropy_coef: float = 0.0
-    max_grad_norm: float = 0.5
-
-
 def gae(rewards: np.ndarray, values: np.ndarray, final_value: float, gamma: float, lam: float) -> np.ndarray:
     """Generalised advantage estimates of one episode; ``final_value`` is V(final_obs) for a
     truncated episode (the horizon cut it, the future was not zero) and 0 for a terminated one."""
@@ -120,8 +117,9 @@ def gae(rewards: np.ndarray, values: np.ndarray, final_value: float, gamma: floa
 
 
 def update(model: ActorCritic, optimiser: torch.optim.Optimizer, episodes: list[EpisodeData], normaliser: Normaliser,
-           settings: PpoSettings, generator: torch.Generator) -> dict:
-    """PPO epochs over every buffered step; returns the losses and the clip fraction."""
+           settings: PpoSpec, generator: torch.Generator) -> dict:
+    """PPO epochs over every buffered step (``settings``: the training YAML's ``ppo`` section);
+    returns the losses and the clip fraction."""
     obs = torch.as_tensor(np.concatenate([normaliser(e.obs) for e in episodes]))
     finals = torch.as_tensor(np.stack([normaliser(e.final_obs) for e in episodes]))
     with torch.no_grad():
@@ -129,7 +127,8 @@ def update(model: ActorCritic, optimiser: torch.optim.Optimizer, episodes: list[
     advantages, start = [], 0
     for k, e in enumerate(episodes):
         v = values[start:start + e.steps]
-        advantages.append(gae(e.rewards, v, float(final_values[k]) if e.truncated else 0.0, settings.gamma, settings.lam))
+        advantages.append(gae(e.rewards, v, float(final_values[k]) if e.truncated else 0.0,
+                              settings.gamma, settings.lam))
         start += e.steps
     adv = np.concatenate(advantages)
     returns = torch.as_tensor(adv + values, dtype=torch.float32)

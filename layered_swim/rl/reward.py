@@ -8,33 +8,18 @@
 Distances are horizontal (SWIM's goals live in the x-y plane). The paper gives no values for the
 a's; ours are chosen so that each factor halves at an error a swimmer would call clearly off:
 0.14 m behind or ahead of schedule, 0.07 m off the line, 20 deg of heading, 20 deg of roll
-beyond the tolerance, a mean joint acceleration of 70 rad/s^2.
+beyond the tolerance, a mean joint acceleration of 70 rad/s^2. The a's and w_accel are the training
+YAML's ``reward`` section, a ``RewardSpec``.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from layered_swim.rl.config import RewardSpec
+
 BODY_POINT_WEIGHTS = {"pelvis": 0.5, "thorax": 0.3, "head": 0.2}   # SWIM's p_body: root, chest, head
-
-
-@dataclass(frozen=True)
-class RewardWeights:
-    forward_per_m: float = 5.0           # a_p
-    deviation_per_m: float = 10.0        # a_a
-    heading_per_rad: float = 2.0         # a_h
-    roll_per_rad: float = 2.0            # a_r
-    accel_s2_per_rad: float = 0.01       # a_s
-    accel_weight: float = 0.1            # w_accel
-
-    def __post_init__(self):
-        for name, value in asdict(self).items():
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0):
-                from layered_swim.config import ConfigError
-
-                raise ConfigError(f"reward weight {name} must be a non-negative number, got {value!r}")
 
 
 def forward_distance_m(on_schedule_m, root_m, direction) -> float:
@@ -58,7 +43,7 @@ def yaw_error_rad(goal_yaws_rad) -> float:
 
 
 def reward_parts(on_schedule_m, root_m, body_point_m, start_m, direction, goal_yaws_rad, roll_rad: float,
-                 roll_tolerance_rad: float, joint_accel_rad_s2, w: RewardWeights = RewardWeights()) -> dict:
+                 roll_tolerance_rad: float, joint_accel_rad_s2, w: RewardSpec = RewardSpec()) -> dict:
     """Every factor of eq. 9 and the total, as floats."""
     forward = math.exp(-w.forward_per_m * forward_distance_m(on_schedule_m, root_m, direction))
     deviation = math.exp(-w.deviation_per_m * deviation_m(body_point_m, start_m, direction))

@@ -3,17 +3,17 @@ per core by default), or on a Ray cluster (``--ray ADDRESS``, the ``[ray]`` extr
 has its own seed, so a run is the same however many workers ran it, wherever."""
 from __future__ import annotations
 
-from concurrent.futures import ProcessPoolExecutor
 import multiprocessing
 import signal
 import sys
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 import torch
 
 from layered_swim.config import ConfigError
 from layered_swim.rl.buffer import EpisodeData
-from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, Normaliser
+from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, ModelArgs, Normaliser
 
 RAY_INSTALL = "pip install -e '.[ray]'"
 
@@ -43,7 +43,8 @@ def play(env, actor: ActorSnapshot, normaliser: Normaliser, seeds: list[int], de
                 break
         episodes.append(EpisodeData(np.array(rows["obs"], np.float32), np.array(rows["actions"], np.float32),
                                     np.array(rows["log_probs"]), np.array(rows["rewards"]), obs.astype(np.float32),
-                                    bool(truncated), info={k: info[k] for k in ("metrics", "termination") if k in info}))
+                                    bool(truncated),
+                                    info={k: info[k] for k in ("metrics", "termination") if k in info}))
     return episodes
 
 
@@ -73,10 +74,10 @@ def _die_with_parent() -> None:
         ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
-def _chunk(model_args: tuple, model_state: dict, normaliser_state: dict, seeds: list[int]):
+def _chunk(model_args: ModelArgs, model_state: dict, normaliser_state: dict, seeds: list[int]):
     model = ActorCritic(*model_args)
     model.load_state_dict(model_state)
-    normaliser = Normaliser(model_args[0])
+    normaliser = Normaliser(model_args.n_obs)
     normaliser.load_state_dict(normaliser_state)
     return play(_ENV, ActorSnapshot(model), normaliser, seeds)
 
@@ -105,7 +106,7 @@ class Rollouts:
         else:
             _set_env(env_kwargs)
 
-    def collect(self, model: ActorCritic, model_args: tuple, normaliser: Normaliser,
+    def collect(self, model: ActorCritic, model_args: ModelArgs, normaliser: Normaliser,
                 seeds: list[int]) -> list[EpisodeData]:
         """One episode per seed, in the seeds' order."""
         state = {k: v.detach().clone() for k, v in model.state_dict().items()}

@@ -19,13 +19,21 @@ import torch
 
 from layered_swim.config import ConfigError, parse
 from layered_swim.outputs import COMMAND_KEY, OutputFolder, atomic_path, claim, folder_path, write_json, write_text
-from layered_swim.rl.buffer import EpisodeBuffer, EvictionSettings
-from layered_swim.rl.config import TrainSpec
-from layered_swim.rl.checkpoint import (CHECKPOINT_FORMAT, MAX_COUNT, adam_state, buffer_episodes, episode_state,
-                                        numpy_rng, read_checkpoint, torch_generator)
+from layered_swim.rl.buffer import EpisodeBuffer
+from layered_swim.rl.checkpoint import (
+    CHECKPOINT_FORMAT,
+    MAX_COUNT,
+    adam_state,
+    buffer_episodes,
+    episode_state,
+    numpy_rng,
+    read_checkpoint,
+    torch_generator,
+)
 from layered_swim.rl.checks import check_normaliser, check_tensors, is_count, is_number
-from layered_swim.rl.policy import Policy, env_arguments, evaluate_goals
-from layered_swim.rl.ppo import ActorCritic, Normaliser, PpoSettings, update
+from layered_swim.rl.config import TrainSpec
+from layered_swim.rl.policy import ResidualPolicy, env_arguments, evaluate_goals
+from layered_swim.rl.ppo import ActorCritic, ModelArgs, Normaliser, update
 from layered_swim.rl.rollouts import Rollouts, make_env
 
 CHECKPOINT, POLICY, LOG = "checkpoint.pt", "policy.pt", "progress.csv"
@@ -35,7 +43,7 @@ LOG_FIELDS = ("epoch", "samples", "wall_s", "samples_per_s", "mean_return", "mea
 
 
 def env_kwargs(spec: TrainSpec) -> dict:
-    return env_arguments(spec.env.model_dump(), spec.reward.model_dump())
+    return env_arguments(spec.env, spec.reward)
 
 
 class Trainer:
@@ -45,28 +53,24 @@ class Trainer:
         n_obs, n_act = probe.observation_space.shape[0], probe.action_space.shape[0]
         self.layout = probe.layout.describe()
         probe.close()
-        self.model_args = (n_obs, n_act, tuple(spec.ppo.hidden), spec.ppo.init_log_std)
+        self.model_args = ModelArgs(n_obs, n_act, tuple(spec.ppo.hidden), spec.ppo.init_log_std)
         torch.manual_seed(spec.run.seed)
         self.model = ActorCritic(*self.model_args)
         self.optimiser = torch.optim.Adam(self.model.parameters(), lr=spec.ppo.learning_rate)
         self.normaliser = Normaliser(n_obs)
-        b = spec.buffer
-        self.buffer = EpisodeBuffer(b.capacity_episodes, b.policy, EvictionSettings(b.e_mid, b.k, b.w_age, b.w_reward, b.sigma))
-        p = spec.ppo
-        self.ppo = PpoSettings(p.gamma, p.lam, p.clip, p.learning_rate, p.epochs, p.minibatch, p.value_coef,
-                               p.entropy_coef, p.max_grad_norm)
+        self.buffer = EpisodeBuffer(spec.buffer)
         self.rng = np.random.default_rng(spec.run.seed)
         self.generator = torch.Generator().manual_seed(spec.run.seed)
         self.epoch, self.samples, self.wall_s = 0, 0, 0.0
         self.ray_address = ray_address
 
     # -- checkpoints ----------------------------------------------------------------------
-    def policy(self) -> Policy:
-        return Policy(self.model, self.normaliser, self.spec.env.model_dump(), self.spec.reward.model_dump(),
-                      self.model_args)
+    def policy(self) -> ResidualPolicy:
+        return ResidualPolicy(self.model, self.normaliser, self.spec.env, self.spec.reward, self.model_args)
 
     def save(self) -> None:
-        state = {"format": CHECKPOINT_FORMAT, "spec": self.spec.model_dump(mode="json"), "model": self.model.state_dict(),
+        state = {"format": CHECKPOINT_FORMAT, "spec": self.spec.model_dump(mode="json"),
+                 "model": self.model.state_dict(),
                  "optimiser": self.optimiser.state_dict(), "normaliser": self.normaliser.state_dict(),
                  "epoch": self.epoch, "samples": self.samples, "wall_s": self.wall_s,
                  "rng": self.rng.bit_generator.state, "generator": self.generator.get_state(),
@@ -86,7 +90,7 @@ class Trainer:
         if _what_trains(spec.model_dump(mode="json")) != _what_trains(self.spec.model_dump(mode="json")):
             raise ConfigError(f"{path}: the checkpoint was trained with another configuration than the one given "
                               f"(see {self.out / 'config.json'})")
-        n_obs, n_act = self.model_args[:2]
+        n_obs, n_act = self.model_args.n_obs, self.model_args.n_act
         weights = check_tensors(state["model"], self.model.state_dict(), "model", path)
         moments = adam_state(state["optimiser"], list(self.model.parameters()), path)
         scaling = check_normaliser(state["normaliser"], n_obs, path)
@@ -121,7 +125,7 @@ class Trainer:
                 episodes = rollouts.collect(self.model, self.model_args, self.normaliser, seeds)
                 self.normaliser.update(np.concatenate([e.obs for e in episodes]))
                 evicted = self.buffer.add(episodes, self.epoch, self.rng)
-                stats = update(self.model, self.optimiser, self.buffer.episodes, self.normaliser, self.ppo,
+                stats = update(self.model, self.optimiser, self.buffer.episodes, self.normaliser, self.spec.ppo,
                                self.generator)
                 new = sum(e.steps for e in episodes)
                 self.samples += new
@@ -174,7 +178,8 @@ def train(spec: TrainSpec, out_dir: OutputFolder | Path, resume: bool = False, p
 def _what_trains(spec: dict) -> dict:
     """The configuration less what a resumed run may change: how long, on how many workers,
     how often it evaluates and saves."""
-    run = {k: v for k, v in spec.get("run", {}).items() if k not in ("samples", "workers", "eval_every", "checkpoint_every")}
+    run = {k: v for k, v in spec.get("run", {}).items()
+           if k not in ("samples", "workers", "eval_every", "checkpoint_every")}
     return {**spec, "run": run}
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 from numba import njit
@@ -36,6 +36,15 @@ def _all_within(values, limit):
         if not abs(v) < limit:
             return False
     return True
+
+
+class Pool(NamedTuple):
+    """The walls a fluid backend's water has (``FluidBackend.container``): the box's lower and upper
+    corner and how far the start must rise for its lowest point to clear the floor."""
+
+    min_m: np.ndarray
+    max_m: np.ndarray
+    lift_m: float
 
 
 class SimulationDiverged(RuntimeError):
@@ -113,10 +122,11 @@ class Simulation:
         pose, _ = self.controller.desired(0.0, None, None)  # the stroke's pose at phase 0 needs no state
         root_m = np.array([*start.position_xy_m, -start.depth_m])
         self.world.reset(root_m, quat, pose, velocity)
-        pool = self.fluid.container(self.world.read_state())
-        if pool is not None and pool[2] > 0.0:
-            self.world.reset(root_m + [0.0, 0.0, pool[2]], quat, pose, velocity)
-        self.world.set_pool(*(pool[:2] if pool is not None else (None, None)))
+        walls = self.fluid.container(self.world.read_state())
+        pool = Pool(*walls) if walls is not None else None
+        if pool is not None and pool.lift_m > 0.0:
+            self.world.reset(root_m + [0.0, 0.0, pool.lift_m], quat, pose, velocity)
+        self.world.set_pool(*((pool.min_m, pool.max_m) if pool is not None else (None, None)))
         self.steps = 0
         self.external_force_n = None
         self.fluid_now = _still(len(self.body.segment_names))

@@ -28,9 +28,20 @@ import numpy as np
 
 from layered_swim.body.model import Body
 from layered_swim.body.urdf import write_urdf
-from layered_swim.sim.articulation import (ANGVEL, FRAME_COLUMNS, FREE, LINVEL, POS, QUAT, REVOLUTE, SPHERICAL,
-                                           Tree, forward_kinematics, generalized_forces,
-                                           mass_matrix_and_bias)
+from layered_swim.sim.articulation import (
+    ANGVEL,
+    FRAME_COLUMNS,
+    FREE,
+    LINVEL,
+    POS,
+    QUAT,
+    REVOLUTE,
+    SPHERICAL,
+    Tree,
+    forward_kinematics,
+    generalized_forces,
+    mass_matrix_and_bias,
+)
 from layered_swim.sim.pd import stable_pd_torques
 from layered_swim.state import BodyState, JointLayout
 

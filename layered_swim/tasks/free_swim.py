@@ -1,7 +1,6 @@
 """Free swimming: the stroke on its own, no target; scored by the run's headline numbers."""
 from __future__ import annotations
 
-
 from layered_swim.state import Start
 from layered_swim.tasks.base import SampleLog, Task, moved_start
 from layered_swim.tasks.metrics import head_top_height_m, summary

@@ -8,14 +8,13 @@ from pathlib import Path
 import numpy as np
 
 from layered_swim.analysis import plots
-from layered_swim.tasks import swim_benchmark as bench
 from layered_swim.analysis.experiments.runner import Outcome
-from layered_swim.analysis.files import write_csv
 from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import load_body
 from layered_swim.control.stroke import load_stroke
 from layered_swim.runs import goal_episode, reach_goal
 from layered_swim.spec import GOAL_TEMPO, SwimSpec
+from layered_swim.tasks import swim_benchmark as bench
 from layered_swim.tasks.goal import GOAL_METRICS
 
 NAME = "current-sweep"
@@ -34,7 +33,8 @@ SPEEDS_M_S = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5)
 QUICK_SPEEDS_M_S = (0.5, 1.0, 1.5)
 STRUGGLE_POS_FACTOR = 2.0     # "struggles": Pos more than twice its quiet-water value
 SWIM_STABLE_M_S = 0.75
-LABELS = {"pos_m": "Pos (m)", "prog": "Prog (1 = on schedule)", "dev_m": "Dev (m)", "roll_deg": "Roll beyond tolerance (deg)"}
+LABELS = {"pos_m": "Pos (m)", "prog": "Prog (1 = on schedule)", "dev_m": "Dev (m)",
+          "roll_deg": "Roll beyond tolerance (deg)"}
 
 
 def configs(quick: bool, seed: int) -> list[dict]:
@@ -46,7 +46,8 @@ def configs(quick: bool, seed: int) -> list[dict]:
 
 
 def run(config: dict) -> dict:
-    episode = goal_episode(SwimSpec.of("current-sweep", stroke=config["stroke"], task={"kind": "goal", "pool": config["pool"]},
+    episode = goal_episode(SwimSpec.of("current-sweep", stroke=config["stroke"],
+                                       task={"kind": "goal", "pool": config["pool"]},
                                        medium={"current_m_s": config["current_m_s"]}))
     try:
         metrics = reach_goal(episode, config["goal"])
@@ -63,11 +64,23 @@ def _mean_over_goals(configs: list[dict], results: list[dict]) -> dict:
     return {key: {k: float(np.mean([r[k] for r in rs])) for k in GOAL_METRICS} for key, rs in groups.items()}
 
 
-def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
+def measure(configs: list[dict], results: list[dict]) -> dict:
     means = _mean_over_goals(configs, results)
     quiet = means[("quiet", 0.0)]
     speeds = sorted({c["speed_m_s"] for c in configs if c["direction"] != "quiet"})
-    write_csv(out_dir / CSV, [{"direction": d, "speed_m_s": s, **m} for (d, s), m in means.items()])
+    struggle = {}
+    for direction in DIRECTIONS:
+        over = [s for s in speeds if means[(direction, s)]["pos_m"] > STRUGGLE_POS_FACTOR * quiet["pos_m"]]
+        struggle[direction] = over[0] if over else None
+    rows = [{"direction": d, "speed_m_s": s, **m} for (d, s), m in means.items()]
+    task = bench.goal_tasks(bench.pool(POOL))[0]
+    return {"rows": rows, "summary": {"quiet": quiet, "pos_doubles_at_m_s": struggle, "means": rows},
+            "means": means, "speeds": speeds, "period_s": load_stroke(STROKE, joint_layout(load_body())).period_s,
+            "episode_s": task.duration_s, "goal_m": task.length_m}
+
+
+def plot(numbers: dict, path: Path) -> None:
+    means, quiet, speeds = numbers["means"], numbers["summary"]["quiet"], numbers["speeds"]
     fig, axes = plots.figure(1, 4, height_in=3.6, width_in=15.0)
     for ax, metric in zip(axes[0], GOAL_METRICS):
         for direction in DIRECTIONS:
@@ -80,11 +93,12 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
         ax.set_title(LABELS[metric].split(" (")[0])
     axes[0, 0].legend(loc="best", fontsize="small")
     fig.suptitle(f"{STROKE}, goal reaching in SWIM's {POOL} pool (mean over its 3 goals) under a uniform current")
-    plots.save(fig, out_dir / FIGURE)
-    struggle = {}
-    for direction in DIRECTIONS:
-        over = [s for s in speeds if means[(direction, s)]["pos_m"] > STRUGGLE_POS_FACTOR * quiet["pos_m"]]
-        struggle[direction] = over[0] if over else None
+    plots.save(fig, path)
+
+
+def describe(numbers: dict) -> Outcome:
+    means, speeds = numbers["means"], numbers["speeds"]
+    quiet, struggle = numbers["summary"]["quiet"], numbers["summary"]["pos_doubles_at_m_s"]
     words = ", ".join(f"{d} at {s:g} m/s" if s is not None else f"{d} not up to {speeds[-1]:g} m/s"
                       for d, s in struggle.items())
     upstream = min(speeds, key=lambda s: means[("-x upstream", s)]["pos_m"])
@@ -95,18 +109,17 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
             f"exceeds twice that: {words}. {helps}At {speeds[-1]:g} m/s: " + "; ".join(
                 f"{d} Pos {means[(d, speeds[-1])]['pos_m']:.2f} m, Prog {means[(d, speeds[-1])]['prog']:.2f}, "
                 f"Dev {means[(d, speeds[-1])]['dev_m']:.2f} m" for d in DIRECTIONS) + ".")
-    period_s = load_stroke(STROKE, joint_layout(load_body())).period_s
-    task = bench.goal_tasks(bench.pool(POOL))[0]
+    period_s, episode_s = numbers["period_s"], numbers["episode_s"]
     earliest = min((s for s in struggle.values() if s is not None), default=None)
     differs = ((f"SWIM's policy holds up to about {SWIM_STABLE_M_S:g} m/s; ours degrades from {earliest:g} m/s. " if
                 earliest is not None and earliest < SWIM_STABLE_M_S else "")
-               + f"In a {task.duration_s:g} s episode our per-cycle layer decides about {task.duration_s / period_s:.1f} "
+               + f"In a {episode_s:g} s episode our per-cycle layer decides about {episode_s / period_s:.1f} "
                f"times ({period_s:.2f} s crawl cycles) and can slow the stroke only to {GOAL_TEMPO.min_tempo:g} of its "
-               f"tempo, while a 0.5 m/s current carries the body {0.5 * task.duration_s:g} m, more than the "
-               f"{task.length_m:.1f} m to the goal. SWIM's quiet-water errors: Pos 0.126 m, Prog 0.712, Dev 0.037 m. "
+               f"tempo, while a 0.5 m/s current carries the body {0.5 * episode_s:g} m, more than the "
+               f"{numbers['goal_m']:.1f} m to the goal. "
+               "SWIM's quiet-water errors: Pos 0.126 m, Prog 0.712, Dev 0.037 m. "
                "Vel is not reported: our strokes are key poses, not a motion-capture reference to "
                "compare joint velocities with.")
     setting = (f"{STROKE}, all three layers, SWIM's {POOL} pool (3 m x 1.5 m; goals 1.5 m ahead, 0 and +-0.375 m "
                "across, 4 s), uniform current of the given speed and direction; diagonal = between +x and +y.")
-    return Outcome(ours, setting, differs, {"quiet": quiet, "pos_doubles_at_m_s": struggle,
-                                            "means": [{"direction": d, "speed_m_s": s, **m} for (d, s), m in means.items()]})
+    return Outcome(ours, setting, differs)

@@ -9,11 +9,9 @@ from matplotlib.ticker import FormatStrFormatter
 
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
-from layered_swim.analysis.files import write_csv
 from layered_swim.control.targets import load_trajectory
 from layered_swim.episode import Episode
-from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S
-from layered_swim.fluid.medium import water
+from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S, water
 from layered_swim.runs import swim
 from layered_swim.sim.simulation import SimulationDiverged
 from layered_swim.tasks import FollowTarget
@@ -36,6 +34,7 @@ FAIL_DISTANCE_M = 2.0      # tracking fails: mean distance to the target over th
 SWIM_SUCCESS_KG_M3 = (920.0, 1500.0)
 TARGET_DEPTH_M = 0.3       # the straight_line trajectory's depth
 DEPTH_TICKS_M = (-0.5, 0.0, 0.5, 1.0, 3.0, 10.0, 30.0, 100.0, 300.0)
+FRESH_KG_M3 = PRESETS_KG_M3_PA_S["fresh_water"][0]
 
 
 def configs(quick: bool, seed: int) -> list[dict]:
@@ -64,22 +63,30 @@ def fails(result: dict) -> bool:
     return "diverged" in result or result["late_distance_m"] > FAIL_DISTANCE_M
 
 
-def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
-    rho = np.array([c["density_kg_m3"] for c in configs])
-    write_csv(out_dir / CSV, [{"density_kg_m3": c["density_kg_m3"], "com_depth_m": r.get("depth_m"),
-                               "mean_distance_m": r.get("mean_distance_m"), "late_distance_m": r.get("late_distance_m"),
-                               "final_distance_m": r.get("final_distance_m"), "tracking_fails": fails(r),
-                               "diverged": r.get("diverged", "")} for c, r in zip(configs, results)])
+def measure(configs: list[dict], results: list[dict]) -> dict:
+    rows = [{"density_kg_m3": c["density_kg_m3"], "com_depth_m": r.get("depth_m"),
+             "mean_distance_m": r.get("mean_distance_m"),
+             "late_distance_m": r.get("late_distance_m"), "final_distance_m": r.get("final_distance_m"),
+             "tracking_fails": fails(r), "diverged": r.get("diverged", "")} for c, r in zip(configs, results)]
+    by_density = [{"density_kg_m3": c["density_kg_m3"], **{
+        k: r.get(k) for k in ("depth_m", "mean_distance_m", "late_distance_m", "final_distance_m", "diverged")},
+        "tracking_fails": fails(r)} for c, r in zip(configs, results)]
+    values = lambda key: np.array([r.get(key, np.nan) for r in results])   # noqa: E731  (NaN: diverged)
+    return {"rows": rows, "summary": {"by_density": by_density}, "seconds": configs[0]["seconds"],
+            "density_kg_m3": np.array([c["density_kg_m3"] for c in configs]),
+            "tracks": np.array([not fails(r) for r in results]),
+            "depth_m": values("depth_m"), "late_distance_m": values("late_distance_m")}
+
+
+def plot(numbers: dict, path: Path) -> None:
+    rho, good = numbers["density_kg_m3"], numbers["tracks"]
     fig, axes = plots.figure(2, 1, height_in=3.2)
     depth_ax, error_ax = axes[:, 0]
-    fresh = PRESETS_KG_M3_PA_S["fresh_water"][0]
-    good = np.array([not fails(r) for r in results])
     for ax in (depth_ax, error_ax):
         ax.axvspan(*SWIM_SUCCESS_KG_M3, color="C2", alpha=0.12, label="SWIM's policy succeeds")
-        ax.axvline(fresh, color="C0", linestyle=":", linewidth=1.0, label="fresh water")
+        ax.axvline(FRESH_KG_M3, color="C0", linestyle=":", linewidth=1.0, label="fresh water")
         ax.set_xlabel("fluid density (kg/m^3)")
-    values = lambda key: np.array([r.get(key, np.nan) for r in results])   # noqa: E731
-    depth = values("depth_m")
+    depth = numbers["depth_m"]
     depth_ax.plot(rho, depth, "o-", color="k")
     depth_ax.axhline(TARGET_DEPTH_M, color="C1", linestyle="--", linewidth=0.8, label="target depth")
     depth_ax.axhline(0.0, color="C0", linewidth=0.8, label="surface")
@@ -91,37 +98,41 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
     depth_ax.set_ylabel("mean depth of the centre of mass (m)")
     depth_ax.set_title(f"{STROKE} following a target moving at 0.5 m/s, 0.3 m deep")
     depth_ax.legend(loc="best", fontsize="small")
-    late = values("late_distance_m")
+    late = numbers["late_distance_m"]
     error_ax.plot(rho, late, "-", color="k")
     error_ax.plot(rho[good], late[good], "o", color="C2", label="tracks")
     error_ax.plot(rho[~good], np.where(np.isnan(late[~good]), FAIL_DISTANCE_M, late[~good]), "x", color="C3",
                   markersize=9, markeredgewidth=2, label="tracking fails")
-    error_ax.axhline(FAIL_DISTANCE_M, color="C3", linestyle="--", linewidth=0.8, label=f"failure threshold {FAIL_DISTANCE_M:g} m")
+    error_ax.axhline(FAIL_DISTANCE_M, color="C3", linestyle="--", linewidth=0.8,
+                     label=f"failure threshold {FAIL_DISTANCE_M:g} m")
     error_ax.set_yscale("log")
     error_ax.set_ylabel("distance to target, 2nd half (m)")
     error_ax.legend(loc="best", fontsize="small")
-    plots.save(fig, out_dir / FIGURE)
-    pairs = [(c["density_kg_m3"], r) for c, r in zip(configs, results) if "diverged" not in r]
-    depths = [r["depth_m"] for _, r in pairs]
+    plots.save(fig, path)
+
+
+def describe(numbers: dict) -> Outcome:
+    by_density = numbers["summary"]["by_density"]
+    swam = [d for d in by_density if d["diverged"] is None]
+    depths = [d["depth_m"] for d in swam]
     monotone = all(a >= b for a, b in zip(depths[:-1], depths[1:]))
-    (rho_lo, light), (rho_hi, dense) = pairs[0], pairs[-1]
-    ours = (f"The centre of mass rides {light['depth_m']:.2f} m deep at {rho_lo:g} kg/m^3 and {dense['depth_m']:.2f} m "
-            f"at {rho_hi:g} kg/m^3 (negative: above the surface); it sinks less "
+    light, dense = swam[0], swam[-1]
+    ours = (f"The centre of mass rides {light['depth_m']:.2f} m deep at {light['density_kg_m3']:g} kg/m^3 and "
+            f"{dense['depth_m']:.2f} m at {dense['density_kg_m3']:g} kg/m^3 (negative: above the surface); "
+            "it sinks less "
             f"{'at every step up in density' if monotone else 'overall as the density grows'}.")
-    tracked = [c["density_kg_m3"] for c, r in zip(configs, results) if not fails(r)]
-    failing = [c["density_kg_m3"] for c, r in zip(configs, results) if fails(r)]
+    tracked = [d["density_kg_m3"] for d in by_density if not d["tracking_fails"]]
+    failing = [d["density_kg_m3"] for d in by_density if d["tracking_fails"]]
     ours += (f" Tracking (mean distance over the run's second half below {FAIL_DISTANCE_M:g} m) holds from "
              f"{min(tracked):g} to {max(tracked):g} kg/m^3" if tracked else " Tracking fails at every density")
     ours += f" and fails at {', '.join(f'{x:g}' for x in failing)} kg/m^3." if failing else " and never fails here."
-    dense_fail = [x for x in failing if x > fresh]
-    light_fail = [x for x in failing if x < fresh]
+    dense_fail = [x for x in failing if x > FRESH_KG_M3]
+    light_fail = [x for x in failing if x < FRESH_KG_M3]
     differs = None
     if not (dense_fail and light_fail):
         where = "at every density here" if not failing else f"only in {'denser' if dense_fail else 'lighter'} fluid"
         differs = f"Yang's swimmer struggles at both ends of the range; ours fails {where}."
-    setting = (f"{STROKE}, all three layers, following `{TRAJECTORY}` for {configs[0]['seconds']:g} s at each density "
+    setting = (f"{STROKE}, all three layers, following `{TRAJECTORY}` for {numbers['seconds']:g} s at each density "
                "(fresh water's viscosity); depth averaged after the first 5 s. Open water with no floor: in a fluid "
                "much lighter than the body it sinks freely.")
-    return Outcome(ours, setting, differs, {"by_density": [{"density_kg_m3": c["density_kg_m3"], **{
-        k: r.get(k) for k in ("depth_m", "mean_distance_m", "late_distance_m", "final_distance_m", "diverged")},
-        "tracking_fails": fails(r)} for c, r in zip(configs, results)]})
+    return Outcome(ours, setting, differs)

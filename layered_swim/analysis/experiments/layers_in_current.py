@@ -8,7 +8,6 @@ import numpy as np
 
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
-from layered_swim.analysis.files import write_csv
 from layered_swim.control.layered import Layers
 from layered_swim.control.targets import load_trajectory
 from layered_swim.episode import Episode
@@ -45,24 +44,32 @@ def run(config: dict) -> dict:
             "target_m": a["target_m"].tolist(), **task.metrics()}
 
 
-def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
+def measure(configs: list[dict], results: list[dict]) -> dict:
     rows = []
     for c, r in zip(configs, results):
         rows += [{"layers": c["layers"], "time_s": t, "swimmer_x_m": s[0], "swimmer_y_m": s[1], "target_x_m": g[0],
                   "target_y_m": g[1], "distance_m": float(np.hypot(s[0] - g[0], s[1] - g[1]))}
                  for t, s, g in zip(r["time_s"], r["swimmer_m"], r["target_m"])]
-    write_csv(out_dir / CSV, rows)
+    runs = [{"layers": c["layers"], "time_s": r["time_s"], "swimmer_m": np.array(r["swimmer_m"]),
+             "distance_m": np.linalg.norm(np.array(r["swimmer_m"])[:, :2] - np.array(r["target_m"])[:, :2], axis=1)}
+            for c, r in zip(configs, results)]
+    tracking = {c["layers"]: {k: r[k] for k in ("mean_distance_m", "final_distance_m", "max_distance_m")}
+                for c, r in zip(configs, results)}
+    return {"rows": rows, "summary": {"tracking": tracking}, "runs": runs, "target_m": np.array(results[0]["target_m"]),
+            "seconds": configs[0]["seconds"]}
+
+
+def plot(numbers: dict, path: Path) -> None:
     fig, axes = plots.figure(1, 3, height_in=4.6, width_in=16.0, gridspec_kw={"width_ratios": [1.0, 1.4, 1.0]})
     paths, near, distance = axes[0]
-    target = np.array(results[0]["target_m"])
+    target = numbers["target_m"]
     for ax in (paths, near):
         ax.plot(target[:, 0], target[:, 1], "k--", linewidth=1.0, label="target path")
-    for c, r in zip(configs, results):
-        xy = np.array(r["swimmer_m"])
-        paths.plot(xy[:, 0], xy[:, 1], label=c["layers"])
-        near.plot(xy[:, 0], xy[:, 1], label=c["layers"])
-        d = np.linalg.norm(xy[:, :2] - np.array(r["target_m"])[:, :2], axis=1)
-        distance.plot(r["time_s"], d, label=c["layers"])
+    for run in numbers["runs"]:
+        xy = run["swimmer_m"]
+        paths.plot(xy[:, 0], xy[:, 1], label=run["layers"])
+        near.plot(xy[:, 0], xy[:, 1], label=run["layers"])
+        distance.plot(run["time_s"], run["distance_m"], label=run["layers"])
     paths.annotate("", xy=(0.12, 0.75), xytext=(0.12, 0.55), xycoords="axes fraction",
                    arrowprops={"arrowstyle": "->", "color": "C0"})
     paths.text(0.15, 0.62, f"current {CURRENT_M_S[1]:g} m/s", transform=paths.transAxes, color="C0", fontsize="small")
@@ -81,10 +88,11 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
     distance.legend(loc="best", fontsize="small")
     fig.suptitle(f"{STROKE} following a target along +x across a {CURRENT_M_S[1]:g} m/s current (+y): "
                  "swimmer's centre of mass and the target")
-    plots.save(fig, out_dir / FIGURE)
-    m = {c["layers"]: {k: r[k] for k in ("mean_distance_m", "final_distance_m", "max_distance_m")}
-         for c, r in zip(configs, results)}
-    basic, cycle, rules = (m[k] for k in LAYER_SETS)
+    plots.save(fig, path)
+
+
+def describe(numbers: dict) -> Outcome:
+    basic, cycle, rules = (numbers["summary"]["tracking"][k] for k in LAYER_SETS)
     closer = rules["mean_distance_m"] < cycle["mean_distance_m"]
     ours = (f"Basic layer alone: swept away, {basic['final_distance_m']:.1f} m from the target at the end "
             f"(mean {basic['mean_distance_m']:.1f} m). With the per-cycle layer: mean distance "
@@ -97,5 +105,5 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
         "target and step back while the per-cycle layer turns (our rules' engagement); crossing the current, the "
         "swimmer turns every cycle, so the rules rarely act at full strength.")
     setting = (f"{STROKE} following `{TRAJECTORY}` (target at 0.5 m/s along +x, 0.3 m deep, starting 2 m ahead), "
-               f"uniform current {CURRENT_M_S} m/s, {configs[0]['seconds']:g} s, fresh water.")
-    return Outcome(ours, setting, differs, {"tracking": m})
+               f"uniform current {CURRENT_M_S} m/s, {numbers['seconds']:g} s, fresh water.")
+    return Outcome(ours, setting, differs)

@@ -4,10 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
-from layered_swim.analysis.files import write_csv
 from layered_swim.control.layered import Layers
 from layered_swim.control.targets import FixedTarget
 from layered_swim.episode import Episode
@@ -37,30 +35,43 @@ def run(config: dict) -> dict:
     return {"time_s": a["time_s"].tolist(), "forward_m": (a["root_pos_m"][:, 0] - a["root_pos_m"][0, 0]).tolist()}
 
 
-def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
-    runs = {(c["stroke"], c["palm"]): r for c, r in zip(configs, results)}
-    write_csv(out_dir / CSV, [{"time_s": t, **{f"{s}_{'palm' if palm else 'basic'}_m": runs[(s, palm)]["forward_m"][i]
-                                               for s in STROKES for palm in (False, True)}}
-                              for i, t in enumerate(results[0]["time_s"])])
+def _label(stroke: str, palm: bool) -> str:
+    return f"{stroke}_{'palm' if palm else 'basic'}"
+
+
+def measure(configs: list[dict], results: list[dict]) -> dict:
+    runs = {_label(c["stroke"], c["palm"]): r for c, r in zip(configs, results)}
+    labels = [_label(s, palm) for s in STROKES for palm in (False, True)]
+    rows = [{"time_s": t, **{f"{label}_m": runs[label]["forward_m"][i] for label in labels}}
+            for i, t in enumerate(results[0]["time_s"])]
+    final = {label: runs[label]["forward_m"][-1] for label in labels}
+    bs_off, bs_on = final["breaststroke_basic"], final["breaststroke_palm"]
+    return {"rows": rows, "summary": {"final_forward_m": final,
+                                      "breaststroke_gain_pct": 100.0 * (bs_on - bs_off) / abs(bs_off)},
+            "seconds": configs[0]["seconds"],
+            "series": {label: (runs[label]["time_s"], runs[label]["forward_m"]) for label in labels}}
+
+
+def plot(numbers: dict, path: Path) -> None:
     fig, axes = plots.figure(1, len(STROKES), height_in=4.0, width_in=11.0)
-    final = {}
     for ax, stroke in zip(axes[0], STROKES):
         for palm, style in ((False, "--"), (True, "-")):
-            r = runs[(stroke, palm)]
-            final[(stroke, palm)] = r["forward_m"][-1]
-            ax.plot(r["time_s"], r["forward_m"], style, label=("with" if palm else "without") + " the palm rule")
+            ax.plot(*numbers["series"][_label(stroke, palm)], style,
+                    label=("with" if palm else "without") + " the palm rule")
         ax.set_xlabel("time (s)")
         ax.set_ylabel("forward displacement of the pelvis (m)")
         ax.set_title(f"{stroke}, basic stroke toward a target straight ahead")
         ax.legend(loc="best", fontsize="small")
-    plots.save(fig, out_dir / FIGURE)
-    seconds = configs[0]["seconds"]
-    tw_off, tw_on = final[("treading_water", False)], final[("treading_water", True)]
-    bs_off, bs_on = final[("breaststroke", False)], final[("breaststroke", True)]
-    gain = 100.0 * (bs_on - bs_off) / abs(bs_off)
+    plots.save(fig, path)
+
+
+def describe(numbers: dict) -> Outcome:
+    final, gain = numbers["summary"]["final_forward_m"], numbers["summary"]["breaststroke_gain_pct"]
+    tw_off, tw_on = final["treading_water_basic"], final["treading_water_palm"]
+    bs_off, bs_on = final["breaststroke_basic"], final["breaststroke_palm"]
     helps_treading = tw_on > tw_off
-    ours = (f"Treading water: in {seconds:g} s the pelvis moves {tw_on:+.2f} m along the direction of the target with "
-            f"the palm rule and {tw_off:+.2f} m without it ({'a gain' if helps_treading else 'no gain'}). "
+    ours = (f"Treading water: in {numbers['seconds']:g} s the pelvis moves {tw_on:+.2f} m along the direction of the "
+            f"target with the palm rule and {tw_off:+.2f} m without it ({'a gain' if helps_treading else 'no gain'}). "
             f"Breaststroke: {bs_on:.1f} m with the rule against {bs_off:.1f} m without, {gain:+.0f} %.")
     differs = None if helps_treading else (
         "Our treading-water stroke does not reproduce the paper's gain. Its hands scull mostly sideways (left hand "
@@ -71,6 +82,4 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
     setting = ("Basic stroke with only the continuous layer's palm rule switched on or off (no per-cycle layer, no "
                f"reach rule), target fixed {TARGET_AHEAD_M:g} m ahead so the desired direction is +x; fresh water; "
                "pelvis position along +x relative to its start.")
-    return Outcome(ours, setting, differs, {"final_forward_m": {f"{s}_{'palm' if p else 'basic'}": v
-                                                                for (s, p), v in final.items()},
-                                            "breaststroke_gain_pct": gain})
+    return Outcome(ours, setting, differs)

@@ -14,7 +14,6 @@ import numpy as np
 
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
-from layered_swim.analysis.files import write_csv
 from layered_swim.body.model import load_body
 from layered_swim.control.targets import load_trajectory
 from layered_swim.episode import Episode
@@ -100,12 +99,12 @@ def recovery(time_s, distance_m, threshold_m: float, push_s: float) -> tuple[boo
     return (True, float(t[back[0]] - push_s), peak) if len(back) else (False, None, peak)
 
 
-def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
+def measure(configs: list[dict], results: list[dict]) -> dict:
     baseline = next(r for c, r in zip(configs, results) if c["kind"] == "none")
     t = np.array(baseline["time_s"])
     threshold = float(np.max(np.array(baseline["distance_m"])[t >= RANDOM_FROM_S])) + BACK_ON_TRACK_M
     quiet_mean = float(np.mean(np.array(baseline["distance_m"])[t >= RANDOM_FROM_S]))
-    rows, impulses, randoms = [], {}, []
+    rows, impulses, randoms = [], {}, []      # impulses: direction -> [(mg, recovered, seconds, peak)]
     for c, r in zip(configs, results):
         d = np.array(r["distance_m"])
         if c["kind"] == "impulse":
@@ -117,11 +116,22 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
             mean = float(d[np.array(r["time_s"]) >= c["from_s"]].mean())
             randoms.append((c["force_n"], mean))
             rows.append({"kind": "random", "direction": "random", "magnitude": c["force_n"], "unit": "N",
-                         "recovered": None, "recovery_s": None, "peak_distance_m": float(d.max()), "mean_distance_m": mean})
-    write_csv(out_dir / CSV, rows)
+                         "recovered": None, "recovery_s": None, "peak_distance_m": float(d.max()),
+                         "mean_distance_m": mean})
+    lost = {d: min([p[0] for p in pts if not p[1]], default=None) for d, pts in impulses.items()}
+    summary = {"on_track_threshold_m": threshold, "not_back_from_mg": lost, "random": [
+        {"force_n": f, "mean_distance_m": m} for f, m in randoms], "unpushed_mean_distance_m": quiet_mean}
+    return {"rows": rows, "summary": summary, "impulses": impulses, "mass_kg": results[0]["weight_n"] / GRAVITY_M_S2,
+            # at SWIM's impulse limit: direction -> (mg, recovered, seconds, peak)
+            "at_limit": {d: next(p for p in pts if p[0] == SWIM_LIMITS["impulse_mg"]) for d, pts in impulses.items()
+                         if any(p[0] == SWIM_LIMITS["impulse_mg"] for p in pts)}}
+
+
+def plot(numbers: dict, path: Path) -> None:
+    threshold, s = numbers["summary"]["on_track_threshold_m"], numbers["summary"]
     fig, axes = plots.figure(1, 3, height_in=4.0, width_in=15.0)
     rec_ax, peak_ax, rand_ax = axes[0]
-    for direction, points in impulses.items():
+    for direction, points in numbers["impulses"].items():
         mg = [p[0] for p in points]
         line, = peak_ax.plot(mg, [p[3] for p in points], "o-", label=direction)
         done = [(p[0], p[2]) for p in points if p[1]]
@@ -143,18 +153,21 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
     peak_ax.set_ylabel("largest distance to the target after the push (m)")
     peak_ax.set_title("how far the push throws the swimmer off")
     peak_ax.legend(loc="best", fontsize="small")
-    forces = [0.0] + [f for f, _ in randoms]
-    rand_ax.plot(forces, [quiet_mean] + [m for _, m in randoms], "o-", color="k")
+    forces = [0.0] + [r["force_n"] for r in s["random"]]
+    rand_ax.plot(forces, [s["unpushed_mean_distance_m"]] + [r["mean_distance_m"] for r in s["random"]], "o-", color="k")
     rand_ax.axvline(SWIM_LIMITS["random_n"], color="0.5", linestyle="--", linewidth=0.8, label="SWIM withstands up to")
     rand_ax.set_xlabel(f"random push on the pelvis, new direction every {RANDOM_HOLD_S:g} s (N)")
     rand_ax.set_ylabel(f"mean distance to the target after {RANDOM_FROM_S:g} s (m)")
     rand_ax.set_title("continuous random pushes")
     rand_ax.legend(loc="best", fontsize="small")
     fig.suptitle(f"{STROKE} following a target at 0.5 m/s (all layers), pushed on the pelvis")
-    plots.save(fig, out_dir / FIGURE)
-    lost = {d: min([p[0] for p in pts if not p[1]], default=None) for d, pts in impulses.items()}
-    at_limit = {d: next(p for p in pts if p[0] == SWIM_LIMITS["impulse_mg"]) for d, pts in impulses.items()
-                if any(p[0] == SWIM_LIMITS["impulse_mg"] for p in pts)}
+    plots.save(fig, path)
+
+
+def describe(numbers: dict) -> Outcome:
+    impulses, at_limit, s = numbers["impulses"], numbers["at_limit"], numbers["summary"]
+    threshold, lost, quiet_mean = s["on_track_threshold_m"], s["not_back_from_mg"], s["unpushed_mean_distance_m"]
+    randoms = [(r["force_n"], r["mean_distance_m"]) for r in s["random"]]
     random_off = [f for f, m in randoms if m > threshold]
     ours = ("Impulses: " + "; ".join(
         f"{d} - " + (f"back on track after every push up to {max(p[0] for p in impulses[d]):g} mg" if lost[d] is None
@@ -166,11 +179,14 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
         + ", ".join(f"{m:.2f} m at {f:g} N" for f, m in randoms)
         + (f"; on average off track (beyond {threshold:.2f} m) from {min(random_off):g} N." if random_off
            else f"; on average on track (within {threshold:.2f} m) up to {randoms[-1][0]:g} N."))
-    setting = (f"{STROKE}, all three layers, following `{TRAJECTORY}` (0.5 m/s) for {SECONDS:g} s. Impulses: a force of "
-               f"k mg (m = {results[0]['weight_n'] / GRAVITY_M_S2:.1f} kg) on the pelvis for {IMPULSE_S:g} s at t = {PUSH_AT_S:g} s. "
-               f"Random pushes: constant magnitude from t = {RANDOM_FROM_S:g} s, direction drawn uniformly on the sphere "
+    setting = (f"{STROKE}, all three layers, following `{TRAJECTORY}` (0.5 m/s) for {SECONDS:g} s. "
+               "Impulses: a force of "
+               f"k mg (m = {numbers['mass_kg']:.1f} kg) on the pelvis for {IMPULSE_S:g} s at t = {PUSH_AT_S:g} s. "
+               f"Random pushes: constant magnitude from t = {RANDOM_FROM_S:g} s, "
+               "direction drawn uniformly on the sphere "
                f"every {RANDOM_HOLD_S:g} s (seeded). On track = within the unperturbed run's largest distance to the "
-               f"target after {RANDOM_FROM_S:g} s ({threshold - BACK_ON_TRACK_M:.2f} m) plus {BACK_ON_TRACK_M:g} m; the "
+               f"target after {RANDOM_FROM_S:g} s ({threshold - BACK_ON_TRACK_M:.2f} m) "
+               f"plus {BACK_ON_TRACK_M:g} m; the "
                "recovery time runs from the push to the first return on track after the largest excursion.")
     ranked = sorted(at_limit, key=lambda d: at_limit[d][3], reverse=True)
     differs = ("SWIM reports freestyle goal reaching; here breaststroke following a line stands in (the "
@@ -178,6 +194,4 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
                "how long its impulses last (ours: 0.1 s). SWIM finds backward and vertical pushes the most disruptive; "
                "ranked by how far a 2 mg push throws ours off: " + ", ".join(
                    f"{d} {at_limit[d][3]:.1f} m" for d in ranked) + ".")
-    numbers = {"on_track_threshold_m": threshold, "not_back_from_mg": lost, "random": [
-        {"force_n": f, "mean_distance_m": m} for f, m in randoms], "unpushed_mean_distance_m": quiet_mean}
-    return Outcome(ours, setting, differs, numbers)
+    return Outcome(ours, setting, differs)

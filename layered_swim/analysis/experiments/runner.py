@@ -1,10 +1,15 @@
-"""Runs one experiment: its configurations through the cached parallel sweep, then its figure,
-CSV and report. An experiment module provides
+"""Runs one experiment: its configurations through the cached parallel sweep, then measures the
+results, writes the CSV, draws the figure and writes the report. An experiment module provides
 
 - ``NAME``, ``TITLE``, ``PAPER`` (the paper's finding, in words), ``FIGURE`` and ``CSV`` file names;
 - ``configs(quick, seed)``: the runs, as JSON-able dicts (they are also the cache keys);
 - ``run(config)``: one simulation, returning a JSON-able result (module level, so it pickles);
-- ``finish(configs, results, out_dir)``: draws the figure, writes the CSV, returns an ``Outcome``;
+- ``measure(configs, results)``: the numbers, as a plain dict; pure (no files, no figure). Its
+  ``"rows"`` (dicts with the same keys) become the CSV, one row per run or point; its ``"summary"``
+  joins ``summary.json`` beside the text; any other keys (series, the setting's parameters) are
+  for ``plot`` and ``describe`` only;
+- ``plot(numbers, path)``: draws the figure from the numbers into ``path``;
+- ``describe(numbers)``: the report's text from the numbers, an ``Outcome`` (ours, setting, differs);
 - optionally ``BACKENDS``, the fluid backends it makes sense on (the plates only by default: a
   sweep of minute-long swims would take days in SPH water). With
   another backend every config carries ``backend`` and ``fluid`` (the backend's settings), which
@@ -12,10 +17,11 @@ CSV and report. An experiment module provides
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from layered_swim.analysis import report
+from layered_swim.analysis.files import write_csv
 from layered_swim.analysis.sweep import run_sweep
 from layered_swim.config import ConfigError
 from layered_swim.outputs import COMMAND_KEY, OutputFolder, claim, write_json, write_text
@@ -24,14 +30,14 @@ from layered_swim.runs import versions
 
 @dataclass(frozen=True)
 class Outcome:
+    """The report's text, which ``describe`` writes from the numbers."""
     ours: str                    # our finding, with our numbers
     setting: str                 # what was simulated
     differs: str | None = None   # where and why ours differs from the paper
-    numbers: dict = field(default_factory=dict)
 
 
-def run_experiment(module, out_dir: OutputFolder | str | Path, quick: bool = False, workers: int = 2, progress: bool = False,
-                   seed: int = 0, backend: str = "plate", fluid_settings=None) -> dict:
+def run_experiment(module, out_dir: OutputFolder | str | Path, quick: bool = False, workers: int = 2,
+                   progress: bool = False, seed: int = 0, backend: str = "plate", fluid_settings=None) -> dict:
     if not isinstance(seed, int) or seed < 0:
         raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
     backends = getattr(module, "BACKENDS", ("plate",))
@@ -44,12 +50,15 @@ def run_experiment(module, out_dir: OutputFolder | str | Path, quick: bool = Fal
     out = claim(out_dir)
     # config.json first: a sweep stopped halfway leaves a folder the next run recognises (and
     # whose cache it reuses), not one it refuses as foreign.
-    write_json(out / "config.json", {COMMAND_KEY: "experiment", "experiment": module.NAME, "quick": quick, "seed": seed, "runs": configs,
-                                      "versions": versions()})
+    write_json(out / "config.json", {COMMAND_KEY: "experiment", "experiment": module.NAME, "quick": quick,
+                                      "seed": seed, "runs": configs, "versions": versions()})
     results = run_sweep(module.run, configs, out / "cache", workers, progress, desc=module.NAME)
-    outcome = module.finish(configs, results, out)
+    numbers = module.measure(configs, results)
+    write_csv(out / module.CSV, numbers["rows"])
+    module.plot(numbers, out / module.FIGURE)
+    outcome = module.describe(numbers)
     summary = {"experiment": module.NAME, "title": module.TITLE, "paper": module.PAPER, "ours": outcome.ours,
-               "differs": outcome.differs, "setting": outcome.setting, **outcome.numbers}
+               "differs": outcome.differs, "setting": outcome.setting, **numbers["summary"]}
     write_json(out / "summary.json", summary)
     write_text(out / "report.md", report.experiment_report(module.TITLE, module.FIGURE, module.CSV, module.PAPER,
                                                            outcome.ours, outcome.setting, outcome.differs))

@@ -13,7 +13,6 @@ import numpy as np
 
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
-from layered_swim.analysis.files import write_csv
 from layered_swim.config import ConfigError
 from layered_swim.tasks import swim_benchmark as bench
 from layered_swim.tasks.goal import GOAL_METRICS
@@ -60,9 +59,9 @@ def run(config: dict) -> dict:
     settings = sph_settings_for(POOL) if fluid == "sph" else None
     try:
         if residual:
-            from layered_swim.rl.policy import Policy, evaluate_goals
+            from layered_swim.rl.policy import ResidualPolicy, evaluate_goals
 
-            scores = evaluate_goals(Policy.load(policy_file(residual)), seeds=1, goals=[config["goal"]],
+            scores = evaluate_goals(ResidualPolicy.load(policy_file(residual)), seeds=1, goals=[config["goal"]],
                                     backend=fluid, fluid_settings=settings)
             return {k: scores[k] for k in GOAL_METRICS}
         episode = goal_episode(SwimSpec.of("swim-table", stroke=STROKE, task={"kind": "goal", "pool": POOL},
@@ -89,14 +88,19 @@ def table(configs: list[dict], results: list[dict]) -> list[dict]:
     return rows
 
 
-def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
+def measure(configs: list[dict], results: list[dict]) -> dict:
     rows = table(configs, results)
     published = bench.SWIM_PUBLISHED[POOL]
-    write_csv(out_dir / CSV, [{**r, "source": "ours"} for r in rows] +
-              [{"controller": name, "fluid": "sph (SWIM)", "pos_m": v["pos_m"][0], "prog": v["prog"][0],
-                "dev_m": v["dev_m"][0], "source": bench.SWIM_PUBLISHED["source"]} for name, v in published.items()])
+    csv_rows = ([{**r, "source": "ours"} for r in rows] +
+                [{"controller": name, "fluid": "sph (SWIM)", "pos_m": v["pos_m"][0], "prog": v["prog"][0],
+                  "dev_m": v["dev_m"][0], "source": bench.SWIM_PUBLISHED["source"]} for name, v in published.items()])
+    return {"rows": csv_rows, "summary": {"rows": rows, "swim_published": published}}
+
+
+def plot(numbers: dict, path: Path) -> None:
+    published = numbers["summary"]["swim_published"]
     fig, axes = plots.figure(1, 3, height_in=3.6)
-    measured = [r for r in rows if r["missing"] is None]
+    measured = [r for r in numbers["summary"]["rows"] if r["missing"] is None]
     labels = [f"{r['controller']}\n({r['fluid']})" for r in measured]
     for ax, key, label in zip(axes[0], ("pos_m", "prog", "dev_m"), ("Pos (m)", "Prog (1 = on schedule)", "Dev (m)")):
         ax.barh(labels, [r[key] for r in measured], color="tab:blue")
@@ -104,11 +108,14 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
         ax.set_xlabel(label)
         ax.invert_yaxis()
     axes[0, 0].legend(loc="best", fontsize="small")
-    plots.save(fig, out_dir / FIGURE)
+    plots.save(fig, path)
+
+
+def describe(numbers: dict) -> Outcome:
     lines = [f"{r['controller']} on {r['fluid']}: " + (r["missing"] if r["missing"] else
              f"Pos {r['pos_m']:.3f} m, Prog {r['prog']:.3f}, Dev {r['dev_m']:.3f} m, Roll {r['roll_deg']:.2f} deg")
-             for r in rows]
-    swim = published["SWIM"]
+             for r in numbers["summary"]["rows"]]
+    swim = numbers["summary"]["swim_published"]["SWIM"]
     ours = ("; ".join(lines) + f". SWIM (published, SPH): Pos {swim['pos_m'][0]} m, Prog {swim['prog'][0]}, "
             f"Dev {swim['dev_m'][0]} m.")
     differs = ("SWIM's residual sits on a captured freestyle clip and trains for 5 M samples; ours sit on our own "
@@ -116,4 +123,4 @@ def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
                "reference) is not measured: our references are key poses, not a captured motion.")
     setting = (f"{STROKE}, SWIM's small pool, its three static goals (mean over them), from SWIM's fixed start; "
                "residual policies deterministic.")
-    return Outcome(ours, setting, differs, {"rows": rows, "swim_published": published})
+    return Outcome(ours, setting, differs)

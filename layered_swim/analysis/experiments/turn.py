@@ -8,7 +8,6 @@ import numpy as np
 
 from layered_swim.analysis import plots
 from layered_swim.analysis.experiments.runner import Outcome
-from layered_swim.analysis.files import write_csv
 from layered_swim.analysis.stroke_metrics import heading_deg
 from layered_swim.control.layered import Layers, fixed_weights
 from layered_swim.control.steering import FORWARD_LOCAL
@@ -33,7 +32,8 @@ def configs(quick: bool, seed: int) -> list[dict]:
 
 
 def run(config: dict) -> dict:
-    episode = Episode(config["stroke"], weights=fixed_weights({config["sequence"]: config["weight"]}, config["basic_cycles"]),
+    episode = Episode(config["stroke"],
+                      weights=fixed_weights({config["sequence"]: config["weight"]}, config["basic_cycles"]),
                       layers=Layers(cycle=True, palm=False, reach=False))
     period_s = episode.stroke.period_s
     a = record(episode, (config["basic_cycles"] + config["perturbed_cycles"]) * period_s, LOG_HZ).arrays()
@@ -48,30 +48,42 @@ def turn_rate_deg_per_cycle(time_s, yaw_deg, from_s: float, period_s: float) -> 
     return float(np.polyfit(t[keep], yaw[keep], 1)[0] * period_s)
 
 
-def finish(configs: list[dict], results: list[dict], out_dir: Path) -> Outcome:
+def measure(configs: list[dict], results: list[dict]) -> dict:
     period_s = results[0]["period_s"]
     start_s = BASIC_CYCLES * period_s
     rates = [turn_rate_deg_per_cycle(r["time_s"], r["yaw_deg"], start_s, period_s) for r in results]
-    write_csv(out_dir / CSV, [{"time_s": t, **{f"yaw_deg_weight_{c['weight']:g}": r["yaw_deg"][i]
-                                               for c, r in zip(configs, results)}}
-                              for i, t in enumerate(results[0]["time_s"])])
+    rows = [{"time_s": t, **{f"yaw_deg_weight_{c['weight']:g}": r["yaw_deg"][i] for c, r in zip(configs, results)}}
+            for i, t in enumerate(results[0]["time_s"])]
+    by_weight = {f"{c['weight']:g}": rate for c, rate in zip(configs, rates)}
+    summary = {"turn_deg_per_cycle": by_weight, "total_turn_deg_at_weight_1": float(results[-1]["yaw_deg"][-1])}
+    return {"rows": rows, "summary": summary, "period_s": period_s, "start_s": start_s,
+            "perturbed_cycles": configs[-1]["perturbed_cycles"],
+            "runs": [{"weight": c["weight"], "time_s": r["time_s"], "yaw_deg": r["yaw_deg"], "deg_per_cycle": rate}
+                     for c, r, rate in zip(configs, results, rates)]}
+
+
+def plot(numbers: dict, path: Path) -> None:
     fig, axes = plots.figure(1, 1, height_in=4.0)
     ax = axes[0, 0]
-    for c, r, rate in zip(configs, results, rates):
-        ax.plot(r["time_s"], r["yaw_deg"], label=f"yaw-left weight {c['weight']:g}: {rate:+.1f} deg/cycle")
-    ax.axvline(start_s, color="0.4", linestyle="--", linewidth=0.8, label="perturbation starts")
+    for run in numbers["runs"]:
+        ax.plot(run["time_s"], run["yaw_deg"],
+                label=f"yaw-left weight {run['weight']:g}: {run['deg_per_cycle']:+.1f} deg/cycle")
+    ax.axvline(numbers["start_s"], color="0.4", linestyle="--", linewidth=0.8, label="perturbation starts")
     ax.set_xlabel("time (s)")
     ax.set_ylabel("yaw, left turn > 0 (deg)")
-    ax.set_title(f"{STROKE}: turning left with the per-cycle layer's yaw-left sequence ({period_s:g} s cycles)")
+    ax.set_title(f"{STROKE}: turning left with the per-cycle layer's yaw-left sequence "
+                 f"({numbers['period_s']:g} s cycles)")
     ax.legend(loc="best", fontsize="small")
-    plots.save(fig, out_dir / FIGURE)
-    by_weight = {f"{c['weight']:g}": rate for c, rate in zip(configs, rates)}
+    plots.save(fig, path)
+
+
+def describe(numbers: dict) -> Outcome:
+    by_weight, total = numbers["summary"]["turn_deg_per_cycle"], numbers["summary"]["total_turn_deg_at_weight_1"]
     drift, full = by_weight["0"], by_weight["1"]
-    total = results[-1]["yaw_deg"][-1]
     ours = (f"The swimmer turns left steadily once the perturbation starts: {full:+.1f} deg per cycle at weight 1 "
             f"and {by_weight['0.5']:+.1f} at weight 0.5, against a drift of {drift:+.1f} deg per cycle without it; "
-            f"{total:.0f} deg in {configs[-1]['perturbed_cycles']} cycles at weight 1. The turn grows with the weight, "
+            f"{total:.0f} deg in {numbers['perturbed_cycles']} cycles at weight 1. The turn grows with the weight, "
             "which is what the per-cycle layer's calibration relies on.")
     setting = (f"{STROKE}, per-cycle layer only (no rules), {BASIC_CYCLES} basic cycles then the yaw-left "
                f"sequence at a fixed weight; yaw of the pelvis's front axis, fresh water.")
-    return Outcome(ours, setting, None, {"turn_deg_per_cycle": by_weight, "total_turn_deg_at_weight_1": float(total)})
+    return Outcome(ours, setting)

@@ -160,8 +160,8 @@ class SphBackend(FluidBackend):
             raise FluidError(f"the SPH water blew up at t = {state.time_s:.3f} s (a particle at {max_speed:.3g} m/s); "
                              "try a smaller time step or particle radius")
         if escaped > MAX_ESCAPED_SHARE:
-            raise FluidError(f"{100 * escaped:.0f} % of the SPH water left the pool by t = {state.time_s:.2f} s (pushed "
-                             "through a wall or the floor by the body); use a larger --pool")
+            raise FluidError(f"{100 * escaped:.0f} % of the SPH water left the pool by t = {state.time_s:.2f} s "
+                             "(pushed through a wall or the floor by the body); use a larger --pool")
         return FluidWrenches(force, torque, self._flow, None)
 
     def _check_inside(self, state: BodyState) -> None:

@@ -15,10 +15,11 @@ MAX_PARTICLES = 2_000_000       # beyond this a 2-core machine takes hours per s
 @dataclass(frozen=True)
 class SphSettings:
     """``pool_size_m``: length (x), width (y) and water depth; SWIM's small pool by default (the
-    commands' ``--pool`` picks its large one, 5 x 2 x 0.7 m). The pool is axis-aligned, centred across the swimmer's start, its back wall
-    ``wall_gap_m`` behind the rearmost point of the body. Viscosity None: the medium's (real water's
-    1e-6 m^2/s kinematic by default). ``mesh_shrink_radii``: the boundary boxes are shrunk by this
-    many particle radii per side, the correction for SPH's fluid-free skin (validate sph)."""
+    commands' ``--pool`` picks its large one, 5 x 2 x 0.7 m). The pool is axis-aligned, centred
+    across the swimmer's start, its back wall ``wall_gap_m`` behind the rearmost point of the body.
+    Viscosity None: the medium's (real water's 1e-6 m^2/s kinematic by default).
+    ``mesh_shrink_radii``: the boundary boxes are shrunk by this many particle radii per side, the
+    correction for SPH's fluid-free skin (validate sph)."""
 
     pool_size_m: tuple[float, float, float] = (3.0, 1.5, 0.5)
     wall_gap_m: float = 0.15

@@ -136,7 +136,8 @@ class SphSolver:
         linvel = np.zeros((n, 3)) if linvel_m_s is None else linvel_m_s
         angvel = np.zeros((n, 3)) if angvel_rad_s is None else angvel_rad_s
         principal = quat_multiply(np.asarray(quat_xyzw, dtype=float), self._offset_inv).tolist()
-        pos, linvel, angvel = np.asarray(pos_m, float).tolist(), np.asarray(linvel).tolist(), np.asarray(angvel).tolist()
+        pos, linvel, angvel = (np.asarray(pos_m, float).tolist(), np.asarray(linvel).tolist(),
+                               np.asarray(angvel).tolist())
         for k, body in enumerate(self.bodies):
             body.setPosition(pos[k])
             body.setRotation(principal[k])

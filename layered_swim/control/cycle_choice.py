@@ -1,4 +1,6 @@
-"""The per-cycle weight policy that steers toward a target (Yang 4.3 + section 5).
+"""The per-cycle layer's choice toward a target (Yang 4.3 + section 5): ``TargetChooser`` picks
+each cycle's weights and tempo (a ``CycleChoice``), with ``TempoControl`` (how hard to swim) and
+``Lead`` (where to aim on a moving target's path).
 
 At each cycle start: where is the target relative to the swimmer (heading error, depth, and the
 shoulder roll averaged over the last cycle against the stroke's own), how much of that to correct
@@ -15,8 +17,8 @@ import numpy as np
 
 from layered_swim.control.calibration import CalibrationTable
 from layered_swim.control.layered import CycleChoice
-from layered_swim.control.stroke import LEVEL_OFF
 from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, bearing_error, glide_pitch, wanted_turns
+from layered_swim.control.stroke import LEVEL_OFF
 from layered_swim.control.targets import Target, target_speed_m_s
 from layered_swim.state import BodyState
 
@@ -94,7 +96,10 @@ class Lead:
         return self.straight_s + (self.bend_s - self.straight_s) * min(1.0, bend / self.full_bend_rad)
 
 
-class TargetPolicy:
+class TargetChooser:
+    """The layered controller's ``CycleChooser`` when it steers toward ``target``: each cycle's
+    weights from the calibration ``table``, its tempo from ``tempo`` and its aim from ``lead``."""
+
     def __init__(self, target: Target, table: CalibrationTable, posture: str,
                  gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead: Lead = Lead(),
                  level_off_beyond_rad: float | None = None, level_off_tempo: float = 1.0):
@@ -140,7 +145,8 @@ class TargetPolicy:
             tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(speed_m_s)))
         self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains,
                                         self.table.pace.roll_at(tempo))
-        near = distance < self.tempo_control.glide_within_m and (not foresight or ahead_of_target_s > self.lead.glide_ahead_s)
+        near = (distance < self.tempo_control.glide_within_m
+                and (not foresight or ahead_of_target_s > self.lead.glide_ahead_s))
         glide = ((near or (waiting and self.tempo_control.glide_within_m > 0))
                  and abs(heading_error) < self.tempo_control.easy_turn_rad)
         weights = {} if glide else self.table.weights_for(self.last_wanted, tempo)
