@@ -454,6 +454,7 @@ def bench_step(seconds: float = 5.0, physics_hz: int | None = None, stroke: str 
     if stroke is None:
         stroke = "front_crawl" if "front_crawl" in available_strokes() else "rest"
     episode = Episode(stroke) if physics_hz is None else Episode(stroke, physics_hz=physics_hz)
+    physics_hz = episode.sim.config.physics_hz
     steps = int(round(seconds * physics_hz))
     world = episode.sim.world
 

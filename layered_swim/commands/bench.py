@@ -14,8 +14,11 @@ def add_parser(subparsers) -> None:
     bench.add_argument("--seconds", type=float,
                        help="simulated seconds per repeat (default 5; 0.5 with SPH; 10 with --env)")
     bench.add_argument("--env", action="store_true", help="time the RL environment: steps per second on one core and "
-                                                          "the shares of physics, observation, reward and policy "
-                                                          "([rl] extra)")
+                                                          "the shares of physics, observation, reward and policy, "
+                                                          "and over all cores with the trainer's workers ([rl] extra)")
+    bench.add_argument("--workers", type=int, help="with --env: also time this many worker processes stepping "
+                                                    "environments at once, as the trainer's rollouts do (default: "
+                                                    "the training config's run.workers; 1: one core only)")
     bench.add_argument("--physics-hz", type=int, help="physics rate in Hz (default 480)")
     backend_option(bench)
 
@@ -30,7 +33,9 @@ def run(args) -> None:
             raise ConfigError("bench --env times the environment on the plate backend")
         from layered_swim.rl.bench import bench_env
 
-        result = bench_env(10.0 if args.seconds is None else args.seconds)
+        if args.workers is not None and not 1 <= args.workers <= 64:
+            raise ConfigError(f"--workers must be in 1..64, got {args.workers}")
+        result = bench_env(10.0 if args.seconds is None else args.seconds, workers=args.workers)
     elif args.backend == "sph":
         result = bench_sph(0.5 if args.seconds is None else args.seconds, fluid_settings(args))
     else:

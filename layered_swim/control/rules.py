@@ -14,13 +14,14 @@ desired direction.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from layered_swim.body.model import Body
 from layered_swim.control.stroke import RulesSpec
-from layered_swim.geometry import quat_rotate
+from layered_swim.geometry import cross, quat_rotate
 from layered_swim.state import JointLayout
 
 PALM_NORMAL_LOCAL = np.array([0.0, 1.0, 0.0])   # the hand box's thin axis
@@ -68,7 +69,7 @@ def rule_offsets(previous: np.ndarray, arms: list[ArmIndices], rules: RulesSpec,
     limit = np.zeros_like(previous)
     for arm in arms:
         flow = flow_m_s[arm.hand] - linvel_m_s[arm.hand]
-        speed = float(np.linalg.norm(flow))
+        speed = math.sqrt(flow.dot(flow))      # np.linalg.norm's own sum for a vector, without its checks
         if speed < MIN_FLOW_M_S:
             continue
         flow_dir = flow / speed
@@ -77,7 +78,7 @@ def rule_offsets(previous: np.ndarray, arms: list[ArmIndices], rules: RulesSpec,
         if palm and (helpfulness > 0.0 or rules.palm.hindering):
             normal = quat_rotate(quat_xyzw[arm.hand], PALM_NORMAL_LOCAL)
             axes = quat_rotate(quat_xyzw[arm.forearm], arm.wrist_axes)
-            turning = np.cross(axes, normal)                       # d(normal)/d(angle), one row per axis
+            turning = cross(axes, normal)                       # d(normal)/d(angle), one row per axis
             facing, along = float(normal @ flow_dir), float(normal @ desired_dir)
             # A flat plate's pressure force lies along its normal, ~ facing*|facing|; its useful part is
             # that times the normal's component along the desired direction. Climb that thrust: the palm

@@ -63,6 +63,9 @@ class Tree:
         object.__setattr__(self, "_params", np.ascontiguousarray(np.column_stack(
             [self.joint_in_parent_m, self.com_in_joint_m, self.axis, self.mass_kg, self.inertia_kg_m2]),
             dtype=np.float64))
+        last = len(self.kind) - 1
+        object.__setattr__(self, "_n_positions", q_at[last] + _SIZES[int(self.kind[last])][0])
+        object.__setattr__(self, "_n_dof", dof_at[last] + _SIZES[int(self.kind[last])][1])
 
     @property
     def n_bodies(self) -> int:
@@ -70,11 +73,11 @@ class Tree:
 
     @property
     def n_positions(self) -> int:
-        return self.positions_of(self.n_bodies - 1).stop
+        return self._n_positions
 
     @property
     def n_dof(self) -> int:
-        return self.rates_of(self.n_bodies - 1).stop
+        return self._n_dof
 
     def positions_of(self, body: int) -> range:
         """Where body ``body``'s joint positions sit in the generalised positions."""

@@ -159,8 +159,7 @@ class Simulation:
             if air is not None:
                 self._breathe(air)
         force = fluid.force_n if self.external_force_n is None else fluid.force_n + self.external_force_n
-        self.world.apply_wrenches(force, fluid.torque_nm, state.pos_m)
-        self.world.drive()
+        self.world.drive_with_wrenches(force, fluid.torque_nm, state.pos_m)
         self.world.step()
         self.steps += 1
         self.state = self.world.read_state()

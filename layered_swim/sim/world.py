@@ -42,7 +42,7 @@ from layered_swim.sim.articulation import (
     generalized_forces,
     mass_matrix_and_bias,
 )
-from layered_swim.sim.pd import stable_pd_torques
+from layered_swim.sim.pd import loads_and_pd, stable_pd_torques
 from layered_swim.state import BodyState, JointLayout
 
 
@@ -266,6 +266,20 @@ class World:
         pybullet.applyExternalTorque(uid, -1, load[0:3].tolist(), frame, cid)
         load[0:6] = 0.0
         self._add_pending(load)
+
+    def drive_with_wrenches(self, force_n: np.ndarray, torque_nm: np.ndarray, at_m: np.ndarray) -> None:
+        """``apply_wrenches`` then ``drive``, in one compiled call (the simulation's every step):
+        the same loads to the same bits."""
+        self._ensure_fresh()
+        tree = self.tree
+        load, self._torque, total = loads_and_pd(tree.index, tree.params, self._frames, self._subspace,
+                                                 self._segment_rows, force_n, torque_nm, at_m, self._q, self._qd,
+                                                 self._target_q, self._target_qd, self._gains, self.dt_s,
+                                                 self.gravity_m_s2)
+        uid, cid, frame = self.uid, self._cid, pybullet.WORLD_FRAME
+        pybullet.applyExternalForce(uid, -1, load[3:6].tolist(), self._q[0:3].tolist(), frame, cid)
+        pybullet.applyExternalTorque(uid, -1, load[0:3].tolist(), frame, cid)
+        self._add_pending(total)
 
     def set_targets(self, pose: np.ndarray, rates: np.ndarray) -> None:
         """Convert a desired pose and its rates into the joints' targets (at control rate)."""
