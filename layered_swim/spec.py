@@ -67,6 +67,7 @@ class SwimSpec(Strict):
     medium: MediumSpec = MediumSpec()
     backend: str = "plate"
     sph: dict | None = None                     # the SPH settings' fields (backend sph)
+    plate: dict | None = None                   # the thin plates' settings' fields (backend plate), e.g. added_mass
     physics_hz: int = Field(PHYSICS_HZ, ge=120, le=5000)
     log_hz: int = Field(DEFAULT_LOG_HZ, ge=1, le=5000)
     tempo: between(0.1, 5.0) = 1.0
@@ -80,13 +81,25 @@ class SwimSpec(Strict):
         Layers.parse(self.layers)                # one line if malformed
         if self.sph is not None and self.backend != "sph":
             raise ConfigError(f"sph settings are for backend sph, not {self.backend}")
+        if self.plate is not None and self.backend != "plate":
+            raise ConfigError(f"plate settings are for backend plate, not {self.backend}")
+        if self.plate is not None:
+            self.fluid_settings()                # one line if a setting is unknown or out of range
 
     @property
     def layer_set(self) -> Layers:
         return Layers.parse(self.layers)
 
     def fluid_settings(self):
-        """The backend's settings object: SPH's from ``sph``; None (its defaults) otherwise."""
+        """The backend's settings object: SPH's from ``sph``, the plates' from ``plate``; None (its
+        defaults) otherwise."""
+        if self.plate is not None:
+            from layered_swim.fluid.thin_plate import PlateSettings
+
+            try:
+                return PlateSettings(**self.plate)
+            except TypeError as err:
+                raise ConfigError(f"plate settings: {err}") from None
         if self.sph is None:
             return None
         from layered_swim.fluid.sph import SphSettings

@@ -1,11 +1,13 @@
 """Real swimmers' ranges from ``layered_swim/reference.md`` (section 3), per stroke,
-and the verdict of a measured number against them (inside / below / above).
+and the verdict of a measured number against them (inside / below / above); and, in one table,
+the targets issue 36 sets the model (``MUST_HOLD``, ``must_hold``), each with its source.
 
 Only its numbers are used; a quantity it gives no range for gets none here, and
-the report says so rather than inventing one.
+the report says so rather than inventing one. An open-ended range has an infinite bound.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 
@@ -91,4 +93,69 @@ def ranges_for(stroke: str, speed_m_s: float | None) -> dict[str, Range]:
     out = dict(RANGES.get(stroke, {}))
     if speed_m_s is not None and stroke in ("front_crawl", "breaststroke"):
         out["active_drag_n"] = active_drag_range(speed_m_s)
+    return out
+
+
+def at_most(high: float, source: str) -> Range:
+    return Range(-math.inf, high, source)
+
+
+def at_least(low: float, source: str) -> Range:
+    return Range(low, math.inf, source)
+
+
+def within(limit: float, source: str) -> Range:
+    return Range(-limit, limit, source)
+
+
+# Real swimmers' figures `validate strokes` adds to RANGES (reference.md section 3).
+PROPELLING_EFFICIENCY = Range(0.3, 0.7, "front-crawl propelling efficiency: ~0.3-0.4 Froude efficiency (Zamparo et "
+                                        "al. 2005) to ~0.45-0.6 with the MAD system (Toussaint et al. 1988) (R)")
+VALIDATION_RANGES: dict[str, dict[str, Range]] = {
+    "front_crawl": {"propelling_efficiency": PROPELLING_EFFICIENCY},
+    "treading_water": {"head_top_above_time_pct": Range(100.0, 100.0, "treading water holds the head up (E, R)")},
+}
+
+# Issue 36: what the model must reach (reference.md section 6), the one table of its targets.
+# Each names the issue and the figure of reference.md it comes from, where it comes from one.
+ISSUE = "issue 36 target"
+MUST_HOLD: dict[str, dict[str, Range]] = {
+    "front_crawl": {
+        "mean_speed_m_s": Range(1.2, 1.8, f"{ISSUE}: a trained crawl, above recreational 0.8-1.2 m/s (R)"),
+        "peak_hand_force_n": Range(70.0, 200.0, f"{ISSUE}: peak hand force 70-150 N typical, 200-300 elite (R)"),
+        "pitch_deg": within(6.0, f"{ISSUE}: a level body"),
+        "shoulder_roll_deg": Range(40.0, 60.0, f"{ISSUE}: shoulder roll 45-60 deg per side (Psycharakis & "
+                                               "Sanders 2010)"),
+        "distance_per_cycle_m": at_least(1.8, f"{ISSUE}: elite 2.2-2.5 m (Hay 1984)"),
+        "joint_power_w": at_most(500.0, f"{ISSUE}: the joints' net mechanical power"),
+    },
+    "breaststroke": {
+        "mean_speed_m_s": Range(0.8, 1.4, f"{ISSUE}: recreational 0.6-1.0 m/s (R) to faster"),
+        "peak_hand_force_n": at_most(200.0, f"{ISSUE}: peak hand force 70-150 N typical (R)"),
+        "pitch_deg": within(12.0, f"{ISSUE}: breaststroke rides higher, still near level"),
+        "face_breath_cycles_pct": Range(100.0, 100.0, f"{ISSUE}: the head above water once a cycle, to breathe"),
+    },
+    "backstroke": {
+        "face_under_time_pct": Range(0.0, 0.0, f"{ISSUE}: a backstroker's face never goes under"),
+    },
+    "butterfly": {
+        "peak_hand_force_n": at_most(200.0, f"{ISSUE}: peak hand force 70-150 N typical (R)"),
+        "distance_per_cycle_m": at_least(1.8, f"{ISSUE}: elite 2.0-2.1 m (Hay 1984)"),
+    },
+}
+# Front crawl's active drag (velocity perturbation method) within these multiples of Narita et al.
+# 2017's measured 32.2 v^3.3 N at the swimmer's own speed.
+ACTIVE_DRAG_TARGET_X = (0.7, 1.5)
+ACTIVE_DRAG_TARGET_STROKES = ("front_crawl",)
+
+
+def must_hold(stroke: str, speed_m_s: float | None) -> dict[str, Range]:
+    """Issue 36's targets for ``stroke`` (the active drag's at ``speed_m_s``)."""
+    out = dict(MUST_HOLD.get(stroke, {}))
+    if speed_m_s is not None and stroke in ACTIVE_DRAG_TARGET_STROKES:
+        k, power, who = ACTIVE_DRAG_LAWS[0]
+        narita = k * abs(speed_m_s) ** power
+        low, high = ACTIVE_DRAG_TARGET_X
+        out["active_drag_n"] = Range(low * narita, high * narita, f"{ISSUE}: {low:g}-{high:g} x {k:g} v^{power:g} N "
+                                                                  f"at this speed ({who}, M)")
     return out

@@ -16,11 +16,13 @@ QUANTITIES = {
     "peak_foot_force_n": ("peak foot force (per cycle, larger foot)", "N", "{:.0f}"),
     "propulsive_force_n": ("mean propulsive force", "N", "{:.0f}"),
     "resistive_force_n": ("mean resistive force", "N", "{:.0f}"),
-    "active_drag_n": ("active drag at the swimming speed", "N", "{:.0f}"),
+    "active_drag_n": ("resistive force summed over segments at the swimming speed (not active drag)", "N",
+                      "{:.0f}"),
     "passive_drag_n": ("passive drag, same body towed in a glide at that speed", "N", "{:.1f}"),
-    "active_drag_per_v2_kg_m": ("active drag / speed^2", "kg/m", "{:.0f}"),
+    "active_drag_per_v2_kg_m": ("summed resistive force / speed^2", "kg/m", "{:.0f}"),
     "mechanical_power_w": ("mechanical power of the joint torques", "W", "{:.0f}"),
-    "propelling_efficiency": ("propelling efficiency", "-", "{:.3f}"),
+    "propelling_efficiency": ("summed resistive force x speed / joint power (not propelling efficiency)", "-",
+                              "{:.3f}"),
 }
 
 DEFINITIONS = """\
@@ -39,12 +41,15 @@ DEFINITIONS = """\
   the amplitude is half its range within a cycle, i.e. the roll to each side.
 - **Forces** are hydrodynamic (the fluid force minus buoyancy). **Propulsive / resistive**: per
   sample, the sum over the 16 segments of the positive / negative parts of each segment's force
-  along the thrust axis. **Active drag** is the mean resistive force at the swimming speed (in
-  steady swimming it equals the mean propulsive force). Counting per segment, limbs recovering
-  against the water count as drag, so this is larger than a whole-body measurement would be.
+  along the thrust axis. The mean resistive force summed over segments (in steady swimming it
+  equals the mean propulsive force; summary key `active_drag_n`) is **not active drag**: a limb
+  recovering against the water and another pulling both count, so it is larger than a whole-body
+  measurement. `layered-swim validate strokes` measures active drag as swimming science does
+  (velocity perturbation method, Kolmogorov & Duplishcheva 1992).
 - **Mechanical power**: the stable-PD torques the joints applied (they close the energy balance
   of a swim) times the joint rates, summed over joints and averaged over the cycle. \
-**Propelling efficiency** = active drag x mean speed / mechanical power.
+The summed resistive force x mean speed / mechanical power (summary key `propelling_efficiency`)
+is not the propelling efficiency either; `validate strokes` gives that from the active drag.
 """
 
 

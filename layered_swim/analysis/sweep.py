@@ -26,7 +26,8 @@ from layered_swim.outputs import write_text
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 DEFAULT_WORKERS = 2     # the machines this project runs on have two cores
 # Modules that only present results: editing a plot or a report must not throw the cache away.
-PRESENTATION_ONLY = {"cli.py", "analysis/plots.py", "analysis/report.py", "analysis/files.py", "analysis/sweep.py"}
+PRESENTATION_ONLY = {"cli.py", "analysis/plots.py", "analysis/report.py", "analysis/files.py", "analysis/sweep.py",
+                     "analysis/validation_report.py", "analysis/validation_figure.py"}
 PRESENTATION_DIRS = ("render/",)   # the window and the video renderer draw runs, never change them
 # One module per experiment: each task's own module joins its key, so editing one experiment
 # recomputes that experiment only.

@@ -65,6 +65,18 @@ def backend_option(command: argparse.ArgumentParser, pool: str | None = "small")
     sph.add_argument("--deterministic", action="store_true", help="one solver thread: bit-identical runs")
 
 
+def added_mass_option(command: argparse.ArgumentParser) -> None:
+    """--added-mass: the thin plates' added mass (``PlateSettings.added_mass``, off by default)."""
+    command.add_argument("--added-mass", action="store_true",
+                         help="each segment carries the water it accelerates (plate backend; off by default: the "
+                              "strokes and every published number are without it; docs/fluid.md)")
+
+
+def plate_fields(args) -> dict | None:
+    """``SwimSpec.plate`` from the command line: None (the plates' defaults) but with --added-mass."""
+    return {"added_mass": True} if getattr(args, "added_mass", False) else None
+
+
 def fluid_settings(args):
     """The backend's settings from the command line: None (its defaults) but for SPH."""
     if args.backend != "sph":
@@ -81,7 +93,7 @@ def swim_spec(args, stroke: str, task: dict, **fields):
     from layered_swim.spec import SwimSpec, sph_fields
 
     return SwimSpec.of("the command line", stroke=stroke, task=task, backend=args.backend,
-                       sph=sph_fields(fluid_settings(args)), **fields)
+                       sph=sph_fields(fluid_settings(args)), plate=plate_fields(args), **fields)
 
 
 def medium(args, current: bool = True) -> dict:

@@ -6,12 +6,20 @@ import json
 import sys
 
 from layered_swim.commands.export import export_option, export_swim, export_target
-from layered_swim.commands.options import backend_option, medium, out_dir, overwrite_option, swim_spec, water_options
+from layered_swim.commands.options import (
+    added_mass_option,
+    backend_option,
+    medium,
+    out_dir,
+    overwrite_option,
+    swim_spec,
+    water_options,
+)
 from layered_swim.commands.tables import flat, fmt, table
 
 # What describes the swim itself: with --config these come from the file, so none may be given.
 SWIM_OPTIONS = ("stroke", "seconds", "lung_air_l", "density", "fluid", "seed", "physics_hz", "tempo", "backend",
-                "pool", "water_depth", "particle_radius", "threads", "deterministic")
+                "pool", "water_depth", "particle_radius", "threads", "deterministic", "added_mass")
 
 
 def add_parser(subparsers) -> None:
@@ -31,6 +39,7 @@ def add_parser(subparsers) -> None:
     water_options(command)
     command.add_argument("--tempo", type=float, default=1.0, help="stroke rate multiplier (default 1)")
     backend_option(command)
+    added_mass_option(command)
     command.set_defaults(swim_defaults={name: command.get_default(name) for name in SWIM_OPTIONS})
 
 

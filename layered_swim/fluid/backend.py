@@ -81,7 +81,8 @@ class FluidBackend:
         return None
 
     def reset(self) -> None:
-        """Forget any state of the water before a new episode (the plates keep none)."""
+        """Forget any state of the water before a new episode (the plates keep none but the added
+        mass's last step)."""
 
     def close(self) -> None:
         """Release what the backend holds (processes, files)."""
