@@ -128,3 +128,11 @@ def test_help_loads_no_heavy_module():
         assert result.returncode == 0, result.stderr
         imported = {line.split("|")[-1].strip().split(".")[0] for line in result.stderr.splitlines() if "|" in line}
         assert not imported & {"pybullet", "torch", "numpy"}, program
+
+
+def test_bench_at_the_default_rate():
+    result = cli("bench", "--seconds", "0.1", "--json")
+    assert result.returncode == 0, result.stderr
+    timing = json.loads(result.stdout)
+    assert timing["physics_hz"] == 480 and timing["steps"] == 48
+    assert 0 < timing["bare_step_us"] < timing["loop_step_us"]
