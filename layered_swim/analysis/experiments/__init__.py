@@ -8,13 +8,14 @@ from layered_swim.analysis.experiments import (
     layers_in_current,
     palm_rule,
     perturbation,
+    swim_generalisation,
     swim_table,
     turn,
 )
 from layered_swim.config import ConfigError
 
 EXPERIMENTS = {m.NAME: m for m in (hand_force, turn, palm_rule, layers_in_current, density_sweep, current_sweep,
-                                   perturbation, swim_table)}
+                                   perturbation, swim_table, swim_generalisation)}
 
 
 def experiment(name: str):
