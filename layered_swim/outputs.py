@@ -66,11 +66,6 @@ def check_out_dir(path: str | Path, command: str, overwrite: bool = False) -> Ou
     return OutputFolder(out, command, overwrite)
 
 
-def prepare_out_dir(path: str | Path, command: str, overwrite: bool = False) -> Path:
-    """``check_out_dir`` and ``claim`` at once, for callers with nothing else to check first."""
-    return claim(check_out_dir(path, command, overwrite))
-
-
 def claim(out: OutputFolder | str | Path) -> Path:
     """The folder, created, locked for this process, earlier output set aside where asked, and
     marked as ours. A plain path is the caller's own folder: only created."""

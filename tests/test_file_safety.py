@@ -12,7 +12,7 @@ import pytest
 from test_cli import REPO, assert_one_line_error, cli
 
 from layered_swim.config import ConfigError, read_text
-from layered_swim.outputs import LOCK, MARKER, PREVIOUS, check_out_dir, claim, prepare_out_dir, release
+from layered_swim.outputs import LOCK, MARKER, PREVIOUS, check_out_dir, claim, release
 
 
 def _tree(folder):
@@ -80,22 +80,22 @@ def test_a_symlinked_out_is_refused_and_its_target_untouched(tmp_path):
 
 
 def test_overwrite_moves_our_earlier_output_aside(tmp_path):
-    out = prepare_out_dir(tmp_path / "r", "run")
+    out = claim(check_out_dir(tmp_path / "r", "run"))
     (out / "config.json").write_text(json.dumps({"command": "run"}))
     (out / "log.npz").write_text("old")
     release(out)
-    assert prepare_out_dir(out, "run") == out                 # the same command again: fine, nothing moved
+    assert claim(check_out_dir(out, "run")) == out                 # the same command again: fine, nothing moved
     assert (out / "log.npz").read_text() == "old"
     release(out)
     with pytest.raises(ConfigError, match="holds the output of `run`.*--overwrite"):
         check_out_dir(out, "analyze")
-    prepare_out_dir(out, "analyze", overwrite=True)
+    claim(check_out_dir(out, "analyze", overwrite=True))
     assert (out / PREVIOUS / "log.npz").read_text() == "old"          # recoverable, not deleted
     assert sorted(p.name for p in out.iterdir()) == sorted([MARKER, LOCK, PREVIOUS])
     assert json.loads((out / MARKER).read_text())["command"] == "analyze"
     release(out)
     (out / "report.md").write_text("second")
-    prepare_out_dir(out, "run", overwrite=True)                       # the one before is dropped
+    claim(check_out_dir(out, "run", overwrite=True))                       # the one before is dropped
     assert _tree(out / PREVIOUS) == ["report.md"]
     release(out)
 
@@ -120,8 +120,8 @@ def test_an_older_version_s_output_is_recognised_by_its_config(tmp_path):
 def test_one_writer_per_folder_and_a_stale_lock_is_taken(tmp_path):
     out = tmp_path / "busy"
     holder = subprocess.Popen([sys.executable, "-c", (
-        "import sys, time\nfrom layered_swim.outputs import prepare_out_dir\n"
-        f"prepare_out_dir({str(out)!r}, 'run')\nprint('held', flush=True)\ntime.sleep(60)\n")],
+        "import sys, time\nfrom layered_swim.outputs import check_out_dir, claim\n"
+        f"claim(check_out_dir({str(out)!r}, 'run'))\nprint('held', flush=True)\ntime.sleep(60)\n")],
         cwd=REPO, stdout=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)})
     try:
         assert holder.stdout.readline().strip() == "held"

@@ -171,8 +171,7 @@ class _Tank:
         force, torque = water.force_n.copy(), water.torque_nm.copy()
         force[0] += force_n
         torque[0] += torque_nm
-        self.world.apply_wrenches(force, torque, state.pos_m)
-        self.world.drive()
+        self.world.drive_with_wrenches(force, torque, state.pos_m)      # as the simulation's step does
         self.world.step()
         return state, water
 

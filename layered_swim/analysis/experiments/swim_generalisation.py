@@ -157,12 +157,11 @@ def _set_viscosity(episode, viscosity_m2_s: float | None) -> None:
         fluid.set_medium(fluid.medium.with_(eta_pa_s=viscosity_m2_s * fluid.medium.rho_kg_m3))
 
 
-def _spec(config: dict, **fields):
+def _spec(config: dict):
     from layered_swim.spec import SwimSpec
 
     return SwimSpec.of(NAME, stroke=config["stroke"], task={"kind": "goal", "pool": config["pool"]},
-                       medium={"density_kg_m3": config["density_kg_m3"], "current_m_s": config["current_m_s"]},
-                       **fields)
+                       medium={"density_kg_m3": config["density_kg_m3"], "current_m_s": config["current_m_s"]})
 
 
 def _outcome(episode, pool: bench.Pool) -> dict:
@@ -198,27 +197,19 @@ def _layered(config: dict, pool: bench.Pool) -> list[dict]:
 
 
 def _residual(config: dict, pool: bench.Pool) -> list[dict]:
-    """The policy in its training environment, on this pool's goal and water: the environment's episode
-    is rebuilt for another density (the stroke is trimmed for the water it is built in), and its own
+    """The policy in its training environment, in this config's water, on this pool's goal; its own
     pool checks are off (a boundless pool), so it swims the whole horizon like the heuristic."""
-    from layered_swim.control.residual import ResidualController
-    from layered_swim.rl.env import REFERENCES, PolicyInput
     from layered_swim.rl.policy import ResidualPolicy
     from layered_swim.rl.ppo import ActorSnapshot
     from layered_swim.rl.rollouts import make_env, play
-    from layered_swim.runs import goal_episode
 
     policy = ResidualPolicy.load(POLICY)
     policy.check_stroke(config["stroke"])
-    env = make_env(policy.env_kwargs(start_jitter=False, pool=config["pool"],
-                                     current_m_s=tuple(config["current_m_s"])))
+    env = make_env(policy.env_kwargs(start_jitter=False, pool=config["pool"], current_m_s=tuple(config["current_m_s"]),
+                                     density_kg_m3=config["density_kg_m3"]))
     runs = []
     try:
         policy.check_sizes(env.observation_space.shape[0], env.action_space.shape[0], "the goal task")
-        if config["density_kg_m3"] != FRESH_KG_M3:
-            built = goal_episode(_spec(config, layers=REFERENCES[policy.env.reference]), wrap=ResidualController)
-            env.episode.close()
-            env.episode, env.input = built, PolicyInput(built, env.env_state)
         _aim(env.episode, pool)
         _set_viscosity(env.episode, config["viscosity_m2_s"])
         env.pool = replace(pool, length_m=1e6, width_m=1e6, depth_m=1e6)
