@@ -23,6 +23,7 @@ from layered_swim.commands import (
     compare,
     experiment,
     export,
+    fit_stroke,
     follow,
     goal,
     render,
@@ -33,10 +34,10 @@ from layered_swim.commands import (
     validate,
 )
 
-# In the order `layered-swim --help` lists them.
-COMMANDS = {module.__name__.rpartition(".")[2]: module
-            for module in (run, strokes, validate, calibrate, follow, goal, render, export, analyze, compare,
-                           experiment, train, soak, bench, app)}
+# In the order `layered-swim --help` lists them; a module's name with '-' for '_' is its command's.
+COMMANDS = {module.__name__.rpartition(".")[2].replace("_", "-"): module
+            for module in (run, strokes, validate, calibrate, fit_stroke, follow, goal, render, export, analyze,
+                           compare, experiment, train, soak, bench, app)}
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -113,7 +113,7 @@ def test_every_command_is_a_module_and_the_cli_only_puts_them_together():
     from layered_swim import cli
 
     names = {p.stem for p in Path(package.__file__).parent.glob("*.py")} - {"__init__", "options", "tables"}
-    assert names == set(cli.COMMANDS)
+    assert {name.replace("_", "-") for name in names} == set(cli.COMMANDS)       # fit_stroke is fit-stroke
     for name in names:
         module = importlib.import_module(f"layered_swim.commands.{name}")
         assert callable(module.add_parser) and callable(module.run), name

@@ -20,6 +20,7 @@ import re
 import shlex
 import subprocess
 import sys
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -253,7 +254,7 @@ def test_the_docs_show_commands():
     assert {"README.md", "cli.md"} <= pages
     assert {c.args[0] for c in COMMANDS if c.program == "layered-swim" and c.args} >= {
         "run", "strokes", "validate", "calibrate", "follow", "goal", "render", "analyze", "compare", "experiment",
-        "train", "soak", "bench"}, "docs/cli.md should show every command"
+        "train", "soak", "bench", "fit-stroke"}, "docs/cli.md should show every command"
     assert any(c.program == "app.py" for c in COMMANDS)
 
 
@@ -276,6 +277,12 @@ def test_yaml_example_loads(where, data):
     try:
         if isinstance(data, dict) and "type" in data:
             build_trajectory(parse_trajectory(data, where), where)
+        elif isinstance(data, dict) and "knobs" in data:
+            from layered_swim.analysis.stroke_fit import load_fit
+
+            with tempfile.TemporaryDirectory() as tmp:
+                (Path(tmp) / "fit.yaml").write_text(yaml.safe_dump(data))
+                load_fit(Path(tmp) / "fit.yaml")
         elif isinstance(data, dict) and "period_s" in data:
             build_stroke(parse_model(StrokeSpec, data, where), joint_layout(load_body()), where)
         else:

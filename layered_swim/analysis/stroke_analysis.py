@@ -34,16 +34,16 @@ PLOTS = {"speed.png": plots.speed_figure, "limb_forces.png": plots.limb_force_fi
 def analysis_config(stroke: str, seconds: float = 60.0, density_kg_m3: float | None = None,
                     current_m_s=(0.0, 0.0, 0.0), fluid: str = "fresh_water", settle_s: float = SETTLE_S,
                     seed: int = 0, physics_hz: int | None = None, backend: str = "plate",
-                    sph: dict | None = None) -> dict:
+                    sph: dict | None = None, plate: dict | None = None) -> dict:
     """The resolved, JSON-able configuration of one analysis (also its cache key); ``sph``: the
-    SPH settings' fields, with ``backend="sph"``."""
+    SPH settings' fields, with ``backend="sph"``; ``plate``: the plates' (``SwimSpec.plate``)."""
     check_seconds(seconds)
     if not (math.isfinite(settle_s) and 0.0 <= settle_s < seconds):
         raise ConfigError(f"settle time must be at least 0 and shorter than the swim ({seconds:g} s), got {settle_s}")
     return {"stroke": stroke, "stroke_file_sha256": file_sha256(stroke_path(stroke)), "seconds": float(seconds),
             "density_kg_m3": density_kg_m3, "current_m_s": [float(c) for c in current_m_s], "fluid": fluid,
             "settle_s": float(settle_s), "seed": seed, "physics_hz": physics_hz or PHYSICS_HZ, "backend": backend,
-            "sph": sph}
+            "sph": sph, "plate": plate}
 
 
 def analysis_spec(config: dict) -> SwimSpec:
@@ -51,7 +51,8 @@ def analysis_spec(config: dict) -> SwimSpec:
     return SwimSpec.of("the analysis", stroke=config["stroke"], seconds=config["seconds"],
                        medium={"fluid": config["fluid"], "density_kg_m3": config["density_kg_m3"],
                                "current_m_s": config["current_m_s"]},
-                       backend=config.get("backend", "plate"), sph=config.get("sph"), physics_hz=config["physics_hz"],
+                       backend=config.get("backend", "plate"), sph=config.get("sph"), plate=config.get("plate"),
+                       physics_hz=config["physics_hz"],
                        log_hz=ANALYSIS_LOG_HZ, seed=config["seed"])
 
 

@@ -52,14 +52,15 @@ METHOD = {
 
 
 def validation_configs(seconds: float = DEFAULT_SECONDS, settle_s: float = SETTLE_S,
-                       buoy_kg_m: float = BUOY_DRAG_KG_M, strokes=STROKES) -> list[dict]:
+                       buoy_kg_m: float = BUOY_DRAG_KG_M, strokes=STROKES, plate: dict | None = None) -> list[dict]:
     """The sweep's jobs: each stroke's free swim and, for a travelling stroke, its swim towing the
-    buoy. Checked: a bad length, settle time or buoy is one ConfigError line."""
+    buoy (``plate``: the plates' settings, e.g. added mass). Checked: a bad length, settle time or
+    buoy is one ConfigError line."""
     if not (isinstance(buoy_kg_m, (int, float)) and math.isfinite(buoy_kg_m) and buoy_kg_m > 0.0):
         raise ConfigError(f"the buoy's drag must be a positive number of kg/m, got {buoy_kg_m}")
     configs = []
     for stroke in strokes:
-        base = analysis_config(stroke, seconds, settle_s=settle_s)
+        base = analysis_config(stroke, seconds, settle_s=settle_s, plate=plate)
         configs.append({**base, "buoy_kg_m": None})
         if stroke in VPM_STROKES:
             configs.append({**base, "buoy_kg_m": float(buoy_kg_m)})

@@ -9,7 +9,7 @@ import sys
 from layered_swim.commands.options import MAX_WORKERS, backend_option, count, fluid_settings, out_dir, overwrite_option
 from layered_swim.commands.tables import fmt, table
 
-STROKES_ONLY = ("seconds", "settle", "workers", "out")      # options of `validate strokes` alone
+STROKES_ONLY = ("seconds", "settle", "workers", "out", "added_mass")      # options of `validate strokes` alone
 
 
 def add_parser(subparsers) -> None:
@@ -27,6 +27,8 @@ def add_parser(subparsers) -> None:
     strokes.add_argument("--settle", type=float, metavar="S", help="seconds left out at the start (default 5)")
     strokes.add_argument("--workers", type=count(1, MAX_WORKERS), help="parallel swims (default 2)")
     strokes.add_argument("--out", help="output folder for report.md, summary.json and the figure (default: none)")
+    strokes.add_argument("--added-mass", action="store_const", const=True,
+                         help="the swims with the plates' added mass (off by default; docs/fluid.md)")
     strokes.add_argument("--no-progress", action="store_true", help="no progress bar")
     overwrite_option(strokes)
 
@@ -39,7 +41,7 @@ def run(args) -> None:
     from layered_swim.fluid.medium import Medium
     from layered_swim.sim.simulation import GRAVITY_M_S2
 
-    given = [f"--{name}" for name in STROKES_ONLY if getattr(args, name) is not None]
+    given = [f"--{name.replace('_', '-')}" for name in STROKES_ONLY if getattr(args, name) is not None]
     if args.what == "strokes":
         return _validate_strokes(args)
     if given:
@@ -71,7 +73,8 @@ def _validate_strokes(args) -> None:
         raise ConfigError("validate strokes swims in the plate water only (--backend plate)")
     out = out_dir(args, None) if args.out is not None else None
     seconds = stroke_validation.DEFAULT_SECONDS if args.seconds is None else args.seconds
-    configs = stroke_validation.validation_configs(seconds, SETTLE_S if args.settle is None else args.settle)
+    configs = stroke_validation.validation_configs(seconds, SETTLE_S if args.settle is None else args.settle,
+                                                   plate={"added_mass": True} if args.added_mass else None)
     folder = claim(out) if out is not None else None      # everything checked: now the folder is ours
     report = stroke_validation.validate_strokes(configs, args.workers or DEFAULT_WORKERS,
                                                 folder / "cache" if folder else None,
