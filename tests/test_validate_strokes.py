@@ -65,7 +65,8 @@ def test_passes_is_a_closed_range_and_none_when_unmeasured():
 
 def _crawl_figures(**changes) -> dict:
     figures = {"mean_speed_m_s": 1.5, "stroke_rate_cpm": 52.0, "distance_per_cycle_m": 1.9, "speed_fluctuation_pct": 17,
-               "pitch_deg": 4.0, "shoulder_roll_deg": 50.0, "hip_roll_deg": 35.0, "peak_hand_force_n": 150.0,
+               "pitch_deg": 4.0, "body_inclination_deg": 3.0, "shoulder_roll_deg": 50.0, "hip_roll_deg": 35.0,
+               "peak_hand_force_n": 150.0,
                "active_drag_n": 32.2 * 1.5**3.3, "resistive_force_summed_n": 130.0, "joint_power_w": 400.0,
                "positive_joint_power_w": 600.0, "propelling_efficiency": 0.4, "face_breath_cycles_pct": 0.0,
                "face_under_time_pct": 100.0, "head_top_above_time_pct": 0.0}
@@ -88,8 +89,9 @@ def test_rows_check_every_target_and_reference():
     assert not any(r["quantity"].startswith(("face", "head")) for r in rows)   # crawl has no such target
 
     failing = {r["quantity"]: r["ok"] for r in validation_rows("front_crawl", _crawl_figures(
-        pitch_deg=-7.0, joint_power_w=1200.0, active_drag_n=None)) if r["kind"] == "must"}
+        pitch_deg=-7.0, body_inclination_deg=20.0, joint_power_w=1200.0, active_drag_n=None)) if r["kind"] == "must"}
     assert failing["pitch_deg"] is False and failing["joint_power_w"] is False
+    assert failing["body_inclination_deg"] is False              # a level pelvis is not enough
     assert failing["active_drag_n"] is None                    # not measured: neither ✔ nor a number
 
 

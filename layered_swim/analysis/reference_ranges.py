@@ -124,6 +124,8 @@ MUST_HOLD: dict[str, dict[str, Range]] = {
         "mean_speed_m_s": Range(1.2, 1.8, f"{ISSUE}: a trained crawl, above recreational 0.8-1.2 m/s (R)"),
         "peak_hand_force_n": Range(70.0, 200.0, f"{ISSUE}: peak hand force 70-150 N typical, 200-300 elite (R)"),
         "pitch_deg": within(6.0, f"{ISSUE}: a level body"),
+        "body_inclination_deg": within(6.0, f"{ISSUE}: a level body, the legs too (a level pelvis with the legs "
+                                            "hanging is not)"),
         "shoulder_roll_deg": Range(40.0, 60.0, f"{ISSUE}: shoulder roll 45-60 deg per side (Psycharakis & "
                                                "Sanders 2010)"),
         "distance_per_cycle_m": at_least(1.8, f"{ISSUE}: elite 2.2-2.5 m (Hay 1984)"),
@@ -133,6 +135,7 @@ MUST_HOLD: dict[str, dict[str, Range]] = {
         "mean_speed_m_s": Range(0.8, 1.4, f"{ISSUE}: recreational 0.6-1.0 m/s (R) to faster"),
         "peak_hand_force_n": at_most(200.0, f"{ISSUE}: peak hand force 70-150 N typical (R)"),
         "pitch_deg": within(12.0, f"{ISSUE}: breaststroke rides higher, still near level"),
+        "body_inclination_deg": within(12.0, f"{ISSUE}: breaststroke rides higher, still near level, the legs too"),
         "face_breath_cycles_pct": Range(100.0, 100.0, f"{ISSUE}: the head above water once a cycle, to breathe"),
     },
     "backstroke": {

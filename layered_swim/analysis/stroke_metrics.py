@@ -43,6 +43,14 @@ def pitch_deg(quat_xyzw, forward_local) -> np.ndarray:
     return np.degrees(np.arcsin(np.clip(forward[..., 2], -1.0, 1.0)))
 
 
+def body_inclination_deg(segment_pos_m, seg: dict) -> np.ndarray:
+    """Elevation of the line from between the feet to the head above the horizontal (head up > 0):
+    the body's inclination as swimming science measures it (e.g. Zamparo et al. 2009)."""
+    pos = np.asarray(segment_pos_m, dtype=float)
+    line = pos[:, seg["head"]] - 0.5 * (pos[:, seg["foot_l"]] + pos[:, seg["foot_r"]])
+    return np.degrees(np.arctan2(line[:, 2], np.linalg.norm(line[:, :2], axis=1)))
+
+
 def heading_deg(quat_xyzw, forward_local) -> np.ndarray:
     """Compass direction of a segment's forward axis seen from above, counterclockwise from +x
     (a left turn increases it), unwrapped so a turn past 180 deg keeps counting."""
@@ -172,6 +180,8 @@ def _series(window: dict, seg: dict, posture: str, forward: np.ndarray, thrust_a
         "resistive_force_n": resistive,
         "joint_power_w": np.gradient(window["joint_work_j"], window["time_s"]),
     }
+    if lying(posture) and {"head", "foot_l", "foot_r"} <= seg.keys():    # a level pelvis, legs hanging, is not level
+        series["body_inclination_deg"] = body_inclination_deg(window["segment_pos_m"], seg)
     for name in LIMBS:
         series[f"{name}_thrust_n"] = hydro[:, seg[name]] @ thrust_axis
         series[f"{name}_force_n"] = np.linalg.norm(hydro[:, seg[name]], axis=1)
@@ -190,6 +200,7 @@ def _cycle_rows(t, window: dict, starts, forward, profiles: dict, travels: bool)
         "shoulder_roll_deg": amplitude(profiles["shoulder_roll_deg"]),
         "hip_roll_deg": amplitude(profiles["hip_roll_deg"]),
         "pitch_deg": means["pitch_deg"], "head_top_m": means["head_top_m"],
+        **({"body_inclination_deg": means["body_inclination_deg"]} if "body_inclination_deg" in means else {}),
         "propulsive_force_n": means["propulsive_force_n"], "resistive_force_n": means["resistive_force_n"],
         "mechanical_power_w": mean_power_w(t, window["joint_work_j"], starts),
         **{f"peak_{name}_force_n": profiles[f"{name}_force_n"].max(axis=1) for name in LIMBS},

@@ -153,6 +153,7 @@ def stroke_figures(free: dict, method: dict | None) -> dict:
         figures.update({
             "mean_speed_m_s": free["speed_m_s"], "distance_per_cycle_m": mean["distance_per_cycle_m"],
             "speed_fluctuation_pct": mean.get("speed_fluctuation_pct"),
+            "body_inclination_deg": mean["body_inclination_deg"],
             "shoulder_roll_deg": mean["shoulder_roll_deg"], "hip_roll_deg": mean["hip_roll_deg"],
             "peak_hand_force_n": mean["peak_hand_force_n"], "active_drag_n": drag,
             "resistive_force_summed_n": mean["resistive_force_n"],
@@ -167,7 +168,8 @@ QUANTITIES = {
     "stroke_rate_cpm": ("stroke rate", "cycles/min", "{:.1f}"),
     "distance_per_cycle_m": ("distance per cycle", "m", "{:.2f}"),
     "speed_fluctuation_pct": ("intracycle speed fluctuation", "+-%", "{:.0f}"),
-    "pitch_deg": ("body pitch", "deg", "{:.1f}"),
+    "pitch_deg": ("body pitch (the pelvis)", "deg", "{:.1f}"),
+    "body_inclination_deg": ("body inclination (feet to head)", "deg", "{:.1f}"),
     "shoulder_roll_deg": ("shoulder roll per side", "deg", "{:.1f}"),
     "hip_roll_deg": ("hip roll per side", "deg", "{:.1f}"),
     "peak_hand_force_n": ("peak hand force", "N", "{:.0f}"),
