@@ -284,7 +284,7 @@ def swim_candidate(job: dict) -> dict:
 
 
 def _plain(value):
-    return float(value) if isinstance(value, (int, float, np.floating)) and value is not None else value
+    return float(value) if isinstance(value, (int, float, np.floating)) else value
 
 
 # --- the search ---------------------------------------------------------------------------------
