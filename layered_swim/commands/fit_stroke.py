@@ -6,7 +6,7 @@ import json
 import sys
 from pathlib import Path
 
-from layered_swim.commands.options import MAX_WORKERS, count, out_dir, overwrite_option, progress
+from layered_swim.commands.options import MAX_WORKERS, count, progress, resumable_options, resumable_out_dir
 
 
 def add_parser(subparsers) -> None:
@@ -19,11 +19,7 @@ def add_parser(subparsers) -> None:
     fit.add_argument("--stroke", help="stroke name or path (default: the fit file's)")
     fit.add_argument("--generations", type=count(1, 100_000), help="generations in all (default: the fit file's)")
     fit.add_argument("--workers", type=count(1, MAX_WORKERS), default=2, help="parallel swims (default 2)")
-    fit.add_argument("--out", help="output folder (default runs/fit-<stroke>)")
-    fit.add_argument("--resume", action="store_true", help="go on with the search in --out")
-    overwrite_option(fit)
-    fit.add_argument("--no-progress", action="store_true", help="no progress bar")
-    fit.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    resumable_options(fit, "runs/fit-<stroke>", "go on with the search in --out")
 
 
 def run(args) -> None:
@@ -35,15 +31,8 @@ def run(args) -> None:
         import cma  # noqa: F401
     except ImportError:
         raise ConfigError("fit-stroke needs the cma library: pip install 'layered-swim[fit]'") from None
-    if args.resume and args.overwrite:
-        raise ConfigError("--resume goes on with the search in --out and --overwrite starts it over: choose one")
     spec, stroke, source = stroke_fit.load_fit(args.targets, stroke=args.stroke, generations=args.generations)
-    out = out_dir(args, Path("runs") / f"fit-{Path(spec.stroke).stem}")
-    history = out.path / stroke_fit.HISTORY
-    if args.resume and not history.is_file():
-        raise ConfigError(f"{out.path}: nothing to resume (no {stroke_fit.HISTORY})")
-    if not args.resume and history.is_file() and not args.overwrite:
-        raise ConfigError(f"{out.path}: holds a search; add --resume to go on with it or --overwrite to start over")
+    out = resumable_out_dir(args, Path("runs") / f"fit-{Path(spec.stroke).stem}", stroke_fit.HISTORY, "search")
     path = claim(out)
     say = None if args.json or progress(args) else (lambda text: print(text, file=sys.stderr))
     result = stroke_fit.fit(spec, stroke, read_text(source), path, workers=args.workers, resume=args.resume,

@@ -38,6 +38,31 @@ def out_dir(args, default: Path):
     return check_out_dir(default if args.out is None else args.out, args.command, args.overwrite)
 
 
+def resumable_options(command: argparse.ArgumentParser, default_out: str, resume_help: str) -> None:
+    """--out, --resume, --overwrite, --no-progress and --json of a long command that can go on
+    from what it saved (train, fit-stroke)."""
+    command.add_argument("--out", help=f"output folder (default {default_out})")
+    command.add_argument("--resume", action="store_true", help=resume_help)
+    overwrite_option(command)
+    command.add_argument("--no-progress", action="store_true", help="no progress bar")
+    command.add_argument("--json", action="store_true", help="print the result as one JSON object")
+
+
+def resumable_out_dir(args, default: Path, saved: str, what: str):
+    """The folder of a resumable command: --resume needs its ``saved`` file there; a folder that
+    holds one is gone on with or started over only when asked."""
+    from layered_swim.config import ConfigError
+
+    if args.resume and args.overwrite:
+        raise ConfigError(f"--resume goes on with the {what} in --out and --overwrite starts it over: choose one")
+    out = out_dir(args, default)
+    if args.resume and not (out.path / saved).is_file():
+        raise ConfigError(f"{out.path}: nothing to resume (no {saved})")
+    if not args.resume and (out.path / saved).is_file() and not args.overwrite:
+        raise ConfigError(f"{out.path}: holds a {what}; add --resume to go on with it or --overwrite to start over")
+    return out
+
+
 def water_options(command: argparse.ArgumentParser) -> None:
     """Density or fluid preset, seed and physics rate: the options of a single swim."""
     fluid = command.add_mutually_exclusive_group()

@@ -5,7 +5,7 @@ import json
 import sys
 from pathlib import Path
 
-from layered_swim.commands.options import MAX_WORKERS, count, out_dir, overwrite_option, progress
+from layered_swim.commands.options import MAX_WORKERS, count, progress, resumable_options, resumable_out_dir
 
 
 def add_parser(subparsers) -> None:
@@ -19,15 +19,10 @@ def add_parser(subparsers) -> None:
     train.add_argument("--buffer", choices=("fifo", "progevict"), help="episode buffer eviction (buffer.eviction)")
     train.add_argument("--ray", metavar="ADDRESS",
                        help="run the rollout workers on a Ray cluster ('local': start one here)")
-    train.add_argument("--out", help="output folder (default runs/train-<stroke>)")
-    train.add_argument("--resume", action="store_true", help="continue the training in --out from its checkpoint")
-    overwrite_option(train)
-    train.add_argument("--no-progress", action="store_true", help="no progress bar")
-    train.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    resumable_options(train, "runs/train-<stroke>", "continue the training in --out from its checkpoint")
 
 
 def run(args) -> None:
-    from layered_swim.config import ConfigError
     from layered_swim.rl.config import load_train_spec
     from layered_swim.rl.train import CHECKPOINT, train
 
@@ -36,14 +31,7 @@ def run(args) -> None:
         if value is not None:
             overrides.append(f"{key}={value}")
     spec = load_train_spec(args.config, overrides)
-    default = Path("runs") / f"train-{spec.env.stroke}"
-    if args.resume and args.overwrite:
-        raise ConfigError("--resume continues the training in --out and --overwrite starts it over: choose one")
-    out = out_dir(args, default)
-    if args.resume and not (out.path / CHECKPOINT).is_file():
-        raise ConfigError(f"{out.path}: nothing to resume (no {CHECKPOINT})")
-    if not args.resume and (out.path / CHECKPOINT).is_file() and not args.overwrite:
-        raise ConfigError(f"{out.path}: holds a training run; add --resume to continue it or --overwrite to start over")
+    out = resumable_out_dir(args, Path("runs") / f"train-{spec.env.stroke}", CHECKPOINT, "training run")
     say = None if args.json or progress(args) else (lambda text: print(text, file=sys.stderr))
     result = train(spec, out, resume=args.resume, progress=progress(args), ray_address=args.ray, say=say)
     if args.json:
