@@ -152,11 +152,12 @@ def test_the_lungs_and_the_water_change_what_the_thorax_carries():
     np.testing.assert_allclose(fluid.added_mass.added[i], fluid.added_mass._per_density[i] * 2000.0)
 
 
-# --- off by default -----------------------------------------------------------------------------
+# --- on by default -------------------------------------------------------------------------------
 
-def test_off_by_default_and_reported_in_the_settings():
+def test_on_by_default_and_reported_in_the_settings():
     fluid = PlateFluid(load_body(), Medium(), 9.81)
-    assert fluid.added_mass is None and fluid.settings()["added_mass"] is False
+    assert fluid.added_mass is not None and fluid.settings()["added_mass"] is True
+    assert PlateFluid(load_body(), Medium(), 9.81, PlateSettings(added_mass=False)).added_mass is None
     assert SwimSpec(stroke="rest").fluid_settings() is None
     with pytest.raises(ConfigError, match="added_mass"):
         PlateSettings(added_mass=1)
@@ -175,13 +176,17 @@ def test_the_swim_spec_turns_it_on_and_repeats_it(tmp_path):
         SwimSpec(stroke="rest", backend="sph", plate={"added_mass": True})
 
 
-def test_run_added_mass_on_the_command_line(tmp_path):
+def test_run_added_mass_on_by_default_and_off_on_the_command_line(tmp_path):
     from layered_swim import cli
 
-    assert cli.main(["run", "--stroke", "rest", "--seconds", "0.5", "--added-mass", "--json",
-                     "--out", str(tmp_path / "on")]) == 0
+    assert cli.main(["run", "--stroke", "rest", "--seconds", "0.5", "--json", "--out", str(tmp_path / "on")]) == 0
     config = json.loads((tmp_path / "on" / "config.json").read_text())
     assert config["fluid_backend"]["settings"]["added_mass"] is True
+    assert cli.main(["run", "--stroke", "rest", "--seconds", "0.5", "--no-added-mass", "--json",
+                     "--out", str(tmp_path / "off")]) == 0
+    config = json.loads((tmp_path / "off" / "config.json").read_text())
+    assert config["fluid_backend"]["settings"]["added_mass"] is False
+    assert config["swim"]["plate"] == {"added_mass": False}
 
 
 # --- validation: springs, a push, the explicit force ---------------------------------------------

@@ -13,27 +13,28 @@ ANALYSIS_FILES = {"summary.json", "config.json", "cycles.csv", "profiles.csv", "
 
 def test_tiny_analyze_writes_files_that_parse(tmp_path):
     out = tmp_path / "bs"
-    result = cli("analyze", "--stroke", "breaststroke", "--seconds", "4.5", "--settle", "1", "--out", str(out),
+    result = cli("analyze", "--stroke", "breaststroke", "--seconds", "6.5", "--settle", "1", "--out", str(out),
                  "--json")
     assert result.returncode == 0, result.stderr
     printed = json.loads(result.stdout)
     assert {p.name for p in out.iterdir() if not p.name.startswith('.layered-swim')} == ANALYSIS_FILES
     summary = json.loads((out / "summary.json").read_text())
     assert summary["stroke"] == printed["stroke"] == "breaststroke"
-    assert summary["cycles"] >= 2 and 50.0 < summary["stroke_rate_cpm"]["mean"] < 65.0
+    assert summary["cycles"] >= 2 and 35.0 < summary["stroke_rate_cpm"]["mean"] < 45.0     # 39.6 nominal
     assert summary["mechanical_power_w"]["mean"] > 0 and 0 < summary["propelling_efficiency"] < 1
     verdicts = {row["quantity"]: row["verdict"] for row in summary["comparison"]}
-    assert verdicts["stroke_rate_cpm"] == "inside" and verdicts["mean_speed_m_s"] in ("below", "inside", "above")
+    # elite breaststrokers swim 50-60 cycles a minute; the re-authored stroke swims 39.6
+    assert verdicts["stroke_rate_cpm"] == "below" and verdicts["mean_speed_m_s"] in ("below", "inside", "above")
     with (out / "cycles.csv").open() as f:
         rows = list(csv.DictReader(f))
-    assert len(rows) == summary["cycles"] and float(rows[0]["duration_s"]) == pytest.approx(1.02, abs=0.02)
+    assert len(rows) == summary["cycles"] and float(rows[0]["duration_s"]) == pytest.approx(1.517, abs=0.03)
     with (out / "profiles.csv").open() as f:
         assert len(list(csv.DictReader(f))) == 101
     for png in ("speed.png", "limb_forces.png", "propulsion_power.png", "attitude.png"):
         assert (out / png).read_bytes()[:8] == PNG_MAGIC
         assert f"]({png})" in (out / "report.md").read_text()
     config = json.loads((out / "config.json").read_text())
-    assert config["swim"]["seconds"] == 4.5 and config["log_hz"] == 120
+    assert config["swim"]["seconds"] == 6.5 and config["log_hz"] == 120
 
 
 def test_hand_force_experiment(tmp_path):

@@ -152,7 +152,8 @@ def test_the_horizon_truncates_and_reports_the_metrics(env):
 
 
 def test_leaving_the_pool_terminates_with_a_reason():
-    e = SwimGoalEnv(reference="basic", goal=0)      # the full-tempo crawl outswims the 4 s schedule
+    # the full-tempo crawl carried by a current along the line outswims the 4 s schedule
+    e = SwimGoalEnv(reference="basic", goal=0, current_m_s=(0.5, 0.0, 0.0))
     e.reset(seed=0)
     for _ in range(120):
         _, _, terminated, truncated, info = e.step(np.zeros(e.action_space.shape, np.float32))

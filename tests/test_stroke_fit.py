@@ -30,11 +30,35 @@ def test_knobs_set_values_times_scale_and_offset():
     assert scaled["keys"]["elbow_r"] == STROKE["keys"]["elbow_r"]                     # the mirror follows its source
 
 
+def test_perturbation_knobs_set_a_sequence_s_offsets_and_scale_them_about_zero(tmp_path):
+    stroke = {**STROKE, "perturbations": {"yaw_left": {"keys": {"elbow_l": {"flexion": {0.0: 0, 0.2: 30, 0.5: -10}}}},
+                                          "yaw_right": {"mirror_of": "yaw_left", "phase_shift": 0.5}}}
+    out = apply_knobs(stroke, {"yaw_left/elbow_l.flexion[1]": 40.0, "yaw_left/elbow_l.flexion:scale": 2.0})
+    assert out["perturbations"]["yaw_left"]["keys"]["elbow_l"]["flexion"] == {0.0: 0.0, 0.2: 80.0, 0.5: -20.0}
+    assert out["keys"] == STROKE["keys"] and out["perturbations"]["yaw_right"] == stroke["perturbations"]["yaw_right"]
+    with pytest.raises(ConfigError, match="'yaw_right' mirrors 'yaw_left': name that sequence"):
+        load_fit(write_fit(tmp_path, knobs={"yaw_right/elbow_l.flexion[1]": {"min": 0, "max": 9}}))
+    with pytest.raises(ConfigError, match="no perturbation sequence 'spin'"):
+        load_fit(write_fit(tmp_path, knobs={"spin/elbow_l.flexion[1]": {"min": 0, "max": 9}}))
+    spec, _, _ = load_fit(write_fit(tmp_path, targets={"yaw_left_deg_per_s": {"min": 30}},
+                                    knobs={"yaw_left/elbow_l.flexion[1]": {"min": 0, "max": 60}}))
+    assert spec.needs_turns() and not spec.needs_towing()
+
+
 def test_rest_knobs_set_a_held_angle_only_where_no_key_sets_it(tmp_path):
     out = apply_knobs(STROKE, {"rest.neck.flexion": -30.0})
     assert out["rest_pose"] == {"neck": {"flexion": -30.0}} and "rest_pose" not in STROKE
     with pytest.raises(ConfigError, match="use elbow_l.flexion:offset"):
         load_fit(write_fit(tmp_path, knobs={"rest.elbow_l.flexion": {"min": 0, "max": 9}}, stroke="front_crawl"))
+
+
+def test_keys_past_the_range_of_motion_stop_at_its_end():
+    lower, upper = {"waist.flexion": -15.0, "neck.flexion": -55.0}, {"waist.flexion": 40.0, "neck.flexion": 60.0}
+    stroke = {"keys": {"waist": {"flexion": {0.0: 50, 0.5: -30, 0.7: 10}}, "hip_r": {"mirror_of": "hip_l"}},
+              "rest_pose": {"neck": {"flexion": -90}}}
+    held = stroke_fit.within_reach(stroke, lower, upper)
+    assert held["keys"]["waist"]["flexion"] == {0.0: 40.0, 0.5: -15.0, 0.7: 10.0}
+    assert held["rest_pose"]["neck"]["flexion"] == -55.0 and held["keys"]["hip_r"] == {"mirror_of": "hip_l"}
 
 
 def test_targets_score_only_what_misses():
@@ -77,9 +101,9 @@ def test_bad_fit_files_are_one_line(tmp_path, changes, words):
 
 
 def test_the_shipped_fit_files_load():
-    for name in ("front_crawl", "breaststroke", "butterfly", "backstroke"):
+    for name in ("front_crawl", "breaststroke", "butterfly", "backstroke", "front_crawl_turns", "breaststroke_turns"):
         spec, stroke, source = load_fit(name)
-        assert spec.stroke == name and stroke["name"] == name and source.is_file()
+        assert spec.stroke == name.removesuffix("_turns") and stroke["name"] == spec.stroke and source.is_file()
 
 
 def cli(*args, cwd):

@@ -169,12 +169,12 @@ def _cli(*args):
 
 def test_validate_strokes_json_on_a_short_swim(tmp_path):
     out = tmp_path / "validation"
-    result = _cli("validate", "strokes", "--seconds", "5", "--settle", "1", "--workers", "2", "--json",
+    result = _cli("validate", "strokes", "--seconds", "7", "--settle", "1", "--workers", "2", "--json",
                   "--out", str(out))
     assert result.returncode == 0, result.stderr
     report = json.loads(result.stdout)
     assert set(report["strokes"]) == {"front_crawl", "breaststroke", "backstroke", "butterfly", "treading_water"}
-    assert report["seconds"] == 5.0 and report["settle_s"] == 1.0 and report["out_dir"] == str(out)
+    assert report["seconds"] == 7.0 and report["settle_s"] == 1.0 and report["out_dir"] == str(out)
     assert "Kolmogorov & Duplishcheva 1992" in report["method"]["active_drag"]
     for stroke, entry in report["strokes"].items():
         assert entry["error"] is None, f"{stroke}: {entry['error']}"

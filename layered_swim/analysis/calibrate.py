@@ -51,7 +51,7 @@ class _CycleAttitude:
             self.positions.append(sim.state.com_m)
 
 
-def _measure(job: tuple[str, str | None, float, float]) -> tuple:
+def calibration_swim(job: tuple[str, str | None, float, float]) -> tuple:
     """One calibration swim: (angle change per cycle about the sequence's axis, mean speed, the
     last cycle's mean roll and pitch, the final depth of the centre of mass); with no sequence
     the change is (yaw, pitch, roll)."""
@@ -94,7 +94,7 @@ def calibrate(stroke: Stroke, tempos=TEMPOS, pace_tempos=PACE_TEMPOS, workers: i
     jobs = [(stroke.source, None, 0.0, tempo) for tempo in pace_tempos]
     jobs += [(stroke.source, seq, w, tempo) for seq in sequences for tempo in tempos for w in weights if w > 0]
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        results = pool.map(_measure, jobs)
+        results = pool.map(calibration_swim, jobs)
         if progress:
             from tqdm import tqdm
             results = tqdm(results, total=len(jobs), desc=f"calibrating {stroke.name}", unit="swim")

@@ -15,6 +15,11 @@ A fit file (YAML) names the stroke, the ranges to reach (``targets``: any figure
 - ``JOINT.AXIS:scale``: every value of the channel pulled towards (< 1) or pushed away from
   (> 1) the channel's mean;
 - ``JOINT.AXIS:offset``: degrees added to every value of the channel;
+- ``SEQ/JOINT.AXIS[K]`` (and ``:time``, ``:scale``, ``:offset``): the same in perturbation
+  sequence SEQ's keys (offsets, degrees; ``:scale`` multiplies them, about 0), e.g.
+  ``yaw_left/elbow_l.flexion[1]``; with the targets
+  ``yaw_left_deg_per_s``/``yaw_right_deg_per_s`` (each yaw sequence's turn at full weight, as
+  ``calibrate`` measures it) the search re-tunes the steering's turns for a changed stroke;
 - ``rest.JOINT.AXIS``: the rest pose's angle (degrees) of a coordinate no key sets (held all
   cycle: the head's or the back's carriage).
 
@@ -34,26 +39,34 @@ import multiprocessing
 import re
 import tempfile
 from concurrent.futures import ProcessPoolExecutor
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 import yaml
 from pydantic import Field, model_validator
 
+from layered_swim.analysis.calibrate import AXIS_INDEX, calibration_swim
 from layered_swim.analysis.stroke_analysis import analysis_config
 from layered_swim.analysis.stroke_validation import BUOY_DRAG_KG_M, QUANTITIES, stroke_figures, swim_measured, vpm
+from layered_swim.body.layout import joint_layout
+from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, Strict, between, file_path, load_yaml, parse, read_text, search_dirs
+from layered_swim.control.calibration import SEQUENCE_AXIS
 from layered_swim.control.stroke import stroke_path
 from layered_swim.outputs import atomic_path, write_json, write_text
+from layered_swim.sim.simulation import SimulationDiverged
 
 HISTORY = "history.jsonl"
 BEST_STROKE = "best.yaml"
 BEST = "best.json"
 RESOLVED = "fit.json"
 NOT_MEASURED_PENALTY = 100.0        # a candidate that blew up, did not cycle, or lacks a targeted figure
-FIGURES = (*QUANTITIES, "active_drag_x_narita")
+TURNS = ("yaw_left_deg_per_s", "yaw_right_deg_per_s")     # each yaw sequence at weight 1, tempo 1
+FIGURES = (*QUANTITIES, "active_drag_x_narita", *TURNS)
 REST = re.compile(r"^rest\.(?P<joint>\w+)\.(?P<axis>\w+)$")
-KNOB = re.compile(r"^(?P<joint>\w+)\.(?P<axis>\w+)(?:\[(?P<index>\d+)\])?(?::(?P<kind>time|scale|offset))?$")
+KNOB = re.compile(r"^(?:(?P<seq>\w+)/)?(?P<joint>\w+)\.(?P<axis>\w+)(?:\[(?P<index>\d+)\])?"
+                  r"(?::(?P<kind>time|scale|offset))?$")
 
 
 class Target(Strict):
@@ -105,7 +118,7 @@ class FitSpec(Strict):
     seconds: between(6.0, 600.0) = 16.0          # each swim's length
     settle_s: between(0.0, 300.0) = 4.0          # left out at the start of each swim
     buoy_kg_m: between(0.0, 1e3, above=True) = BUOY_DRAG_KG_M
-    added_mass: bool = False                     # the swims with the plates' added mass (docs/fluid.md)
+    added_mass: bool = True                      # false: the swims without the plates' added mass
     population: int = Field(12, ge=4, le=512)
     generations: int = Field(60, ge=1, le=100_000)
     sigma: between(0.0, 0.5, above=True) = 0.2   # CMA-ES's first step, a fraction of each knob's range
@@ -133,6 +146,9 @@ class FitSpec(Strict):
     def needs_towing(self) -> bool:
         return any(name in ("active_drag_n", "active_drag_x_narita", "propelling_efficiency") for name in self.targets)
 
+    def needs_turns(self) -> bool:
+        return any(name in TURNS for name in self.targets)
+
 
 def load_fit(path: str | Path, stroke: str | None = None, generations: int | None = None
              ) -> tuple[FitSpec, dict, Path]:
@@ -156,8 +172,20 @@ def load_fit(path: str | Path, stroke: str | None = None, generations: int | Non
     return spec, stroke_data, source
 
 
-def _channel(stroke: dict, joint: str, axis: str) -> dict:
-    keys = stroke.get("keys") or {}
+def _keys(stroke: dict, seq: str | None) -> dict:
+    """The basic cycle's keys, or perturbation sequence ``seq``'s (offsets)."""
+    if seq is None:
+        return stroke.get("keys") or {}
+    sequence = (stroke.get("perturbations") or {}).get(seq)
+    if sequence is None:
+        raise ConfigError(f"the stroke has no perturbation sequence '{seq}'")
+    if "mirror_of" in sequence:
+        raise ConfigError(f"'{seq}' mirrors '{sequence['mirror_of']}': name that sequence")
+    return sequence.get("keys") or {}
+
+
+def _channel(stroke: dict, joint: str, axis: str, seq: str | None = None) -> dict:
+    keys = _keys(stroke, seq)
     if joint not in keys:
         raise ConfigError(f"the stroke has no keys for joint '{joint}'")
     entry = keys[joint]
@@ -188,7 +216,7 @@ def check_knob(stroke: dict, name: str, knob: Knob, knobs: dict) -> None:
                               f"nothing: use {rest['joint']}.{rest['axis']}:offset")
         return
     m = KNOB.match(name)
-    channel = _channel(stroke, m["joint"], m["axis"])
+    channel = _channel(stroke, m["joint"], m["axis"], m["seq"])
     if (m["index"] is None) != (m["kind"] in ("scale", "offset")):
         raise ConfigError("a key knob names its key (JOINT.AXIS[K]); a :scale or :offset knob does not")
     if m["index"] is None:
@@ -201,7 +229,7 @@ def check_knob(stroke: dict, name: str, knob: Knob, knobs: dict) -> None:
     for k, other in enumerate(sorted(channel, key=float)):
         if k == int(m["index"]):
             continue
-        moved = knobs.get(f"{m['joint']}.{m['axis']}[{k}]:time")
+        moved = knobs.get(f"{m['seq'] + '/' if m['seq'] else ''}{m['joint']}.{m['axis']}[{k}]:time")
         low, high = (moved.min, moved.max) if moved else (float(other), float(other))
         if not (high < knob.min or low > knob.max):
             raise ConfigError(f"its range {knob.min:g}-{knob.max:g} meets key {k}'s time ({low:g}-{high:g}): "
@@ -215,7 +243,7 @@ def apply_knobs(stroke: dict, values: dict[str, float]) -> dict:
     if "period_s" in values:
         out["period_s"] = float(values["period_s"])
     later = []
-    moves: dict[tuple[str, str], dict] = {}
+    moves: dict[tuple, dict] = {}
     for name, value in values.items():
         rest = REST.match(name)
         if rest:
@@ -225,26 +253,45 @@ def apply_knobs(stroke: dict, values: dict[str, float]) -> dict:
         if name == "period_s" or m is None:
             continue
         if m["index"] is None:
-            later.append((m["kind"], m["joint"], m["axis"], float(value)))
+            later.append((m["kind"], m["seq"], m["joint"], m["axis"], float(value)))
             continue
-        channel = out["keys"][m["joint"]][m["axis"]]
+        channel = _keys(out, m["seq"])[m["joint"]][m["axis"]]
         t = _key_time(channel, m["index"])
         if m["kind"] == "time":
-            moves.setdefault((m["joint"], m["axis"]), {})[t] = float(value)
+            moves.setdefault((m["seq"], m["joint"], m["axis"]), {})[t] = float(value)
         else:
             channel[t] = float(value)
-    for (joint, axis), moved in moves.items():
-        channel = out["keys"][joint][axis]
-        out["keys"][joint][axis] = dict(sorted(((round(moved.get(t, t), 4), v) for t, v in channel.items()),
-                                               key=lambda item: item[0]))
+    for (seq, joint, axis), moved in moves.items():
+        keys = _keys(out, seq)
+        keys[joint][axis] = dict(sorted(((round(moved.get(t, t), 4), v) for t, v in keys[joint][axis].items()),
+                                        key=lambda item: item[0]))
     for kind in ("scale", "offset"):
-        for knob_kind, joint, axis, value in later:
+        for knob_kind, seq, joint, axis, value in later:
             if knob_kind != kind:
                 continue
-            channel = out["keys"][joint][axis]
-            mean = float(np.mean(list(channel.values())))
+            channel = _keys(out, seq)[joint][axis]
+            mean = float(np.mean(list(channel.values()))) if seq is None else 0.0    # offsets scale about 0
             for t, v in channel.items():
                 channel[t] = mean + value * (v - mean) if kind == "scale" else v + value
+    return out
+
+
+def within_reach(stroke: dict, lower_deg: dict[str, float], upper_deg: dict[str, float]) -> dict:
+    """The stroke data with every key and rest angle held inside its joint's range of motion
+    (``JOINT.AXIS`` -> degrees): a knob that would push a key past it stops at the end, so a
+    search step there is a body at its limit, not a stroke file the loader refuses. Pure."""
+    out = copy.deepcopy(stroke)
+    for section in ("keys", "rest_pose"):
+        for joint, axes in (out.get(section) or {}).items():
+            for axis, value in axes.items():
+                name = f"{joint}.{axis}"
+                if name not in lower_deg:
+                    continue
+                low, high = lower_deg[name], upper_deg[name]
+                if isinstance(value, dict):
+                    axes[axis] = {t: min(max(float(v), low), high) for t, v in value.items()}
+                elif isinstance(value, (int, float)):
+                    axes[axis] = min(max(float(value), low), high)
     return out
 
 
@@ -266,13 +313,14 @@ def swim_candidate(job: dict) -> dict:
     towing the buoy where asked); every figure, or the error line."""
     with tempfile.TemporaryDirectory(prefix="fit-stroke-") as tmp:
         path = Path(tmp) / f"{job['stroke']['name']}.yaml"
-        path.write_text(yaml.safe_dump(job["stroke"], sort_keys=False))
+        path.write_text(yaml.safe_dump(within_reach(job["stroke"], *_ranges_deg()), sort_keys=False))
         try:
             base = analysis_config(str(path), job["seconds"], settle_s=job["settle_s"],
-                                   plate={"added_mass": True} if job["added_mass"] else None)
+                                   plate=None if job["added_mass"] else {"added_mass": False})
             free = swim_measured({**base, "buoy_kg_m": None})
             towing = swim_measured({**base, "buoy_kg_m": job["buoy_kg_m"]}) if job["towing"] else None
-        except ConfigError as err:
+            turns = turns_deg_per_s(str(path), float(job["stroke"]["period_s"])) if job["turns"] else {}
+        except (ConfigError, SimulationDiverged) as err:
             return {"error": str(err)}
     for swum in (free, towing):
         if swum is not None and "error" in swum:
@@ -280,7 +328,28 @@ def swim_candidate(job: dict) -> dict:
     method = vpm(free, towing, job["buoy_kg_m"]) if towing is not None else None
     figures = stroke_figures(free, method)
     figures["active_drag_x_narita"] = method["ratio_to_narita"] if method else None
-    return {"figures": {k: _plain(v) for k, v in figures.items()}}
+    return {"figures": {k: _plain(v) for k, v in {**figures, **turns}.items()}}
+
+
+def turns_deg_per_s(path: str, period_s: float) -> dict[str, float]:
+    """How fast each yaw sequence turns the swimmer at full weight and tempo 1, as ``calibrate``
+    measures it (its turn per cycle less the unperturbed drift), per second: a slower stroke
+    turns less often, and steering needs turns per second."""
+    drift = calibration_swim((path, None, 0.0, 1.0))[0][AXIS_INDEX["yaw"]]
+    out = {}
+    for name in TURNS:
+        sequence = name.removesuffix("_deg_per_s")
+        sign = SEQUENCE_AXIS[sequence][1]
+        out[name] = math.degrees(sign * (calibration_swim((path, sequence, 1.0, 1.0))[0] - drift)) / period_s
+    return out
+
+
+@lru_cache(maxsize=1)
+def _ranges_deg() -> tuple[dict[str, float], dict[str, float]]:
+    """Every joint coordinate's range of motion in degrees, by ``JOINT.AXIS``."""
+    layout = joint_layout(load_body())
+    return ({n: math.degrees(v) for n, v in zip(layout.names, layout.lower_rad)},
+            {n: math.degrees(v) for n, v in zip(layout.names, layout.upper_rad)})
 
 
 def _plain(value):
@@ -318,7 +387,7 @@ class Search:
             elif m["kind"] == "offset":
                 values.append(0.0)
             else:
-                channel = self.stroke["keys"][m["joint"]][m["axis"]]
+                channel = _keys(self.stroke, m["seq"])[m["joint"]][m["axis"]]
                 t = _key_time(channel, m["index"])
                 values.append(float(t) if m["kind"] == "time" else float(channel[t]))
         return np.array(values)
@@ -387,7 +456,8 @@ def fit(spec: FitSpec, stroke: dict, stroke_text: str, out: Path, workers: int =
 
     def swim_all(candidates: list[dict]) -> list[dict]:
         jobs = [{"stroke": apply_knobs(stroke, knobs), "seconds": spec.seconds, "settle_s": spec.settle_s,
-                 "buoy_kg_m": spec.buoy_kg_m, "towing": spec.needs_towing(), "added_mass": spec.added_mass}
+                 "buoy_kg_m": spec.buoy_kg_m, "towing": spec.needs_towing(), "turns": spec.needs_turns(),
+                 "added_mass": spec.added_mass}
                 for knobs in candidates]
         return list(pool.map(swim_candidate, jobs))
 
@@ -431,7 +501,7 @@ def _record(search: Search, out: Path, key: str, generation: int, xs, knobs: lis
     best = best_of(search.history)
     with atomic_path(out / BEST_STROKE) as path:
         Path(path).write_text(_stroke_header(search.spec, best) + yaml.safe_dump(
-            apply_knobs(search.stroke, best["knobs"]), sort_keys=False))
+            within_reach(apply_knobs(search.stroke, best["knobs"]), *_ranges_deg()), sort_keys=False))
     write_json(out / BEST, best)
     return scores
 

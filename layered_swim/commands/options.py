@@ -91,15 +91,14 @@ def backend_option(command: argparse.ArgumentParser, pool: str | None = "small")
 
 
 def added_mass_option(command: argparse.ArgumentParser) -> None:
-    """--added-mass: the thin plates' added mass (``PlateSettings.added_mass``, off by default)."""
-    command.add_argument("--added-mass", action="store_true",
-                         help="each segment carries the water it accelerates (plate backend; off by default: the "
-                              "strokes and every published number are without it; docs/fluid.md)")
+    """--no-added-mass: the thin plates without their added mass (``PlateSettings.added_mass``, on by default)."""
+    command.add_argument("--no-added-mass", dest="added_mass", action="store_false",
+                         help="leave out the water each segment carries (plate backend; on by default; docs/fluid.md)")
 
 
 def plate_fields(args) -> dict | None:
-    """``SwimSpec.plate`` from the command line: None (the plates' defaults) but with --added-mass."""
-    return {"added_mass": True} if getattr(args, "added_mass", False) else None
+    """``SwimSpec.plate`` from the command line: None (the plates' defaults) but with --no-added-mass."""
+    return {"added_mass": False} if not getattr(args, "added_mass", True) else None
 
 
 def fluid_settings(args):

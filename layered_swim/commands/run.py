@@ -63,7 +63,8 @@ def _repeat(args) -> None:
     from layered_swim.outputs import check_out_dir
     from layered_swim.runs import default_out_dir, follow_run, goal_run, repeatable, run_swim
 
-    given = [f"--{name.replace('_', '-')}" for name in SWIM_OPTIONS if getattr(args, name) != args.swim_defaults[name]]
+    given = ["--no-added-mass" if name == "added_mass" else f"--{name.replace('_', '-')}"
+             for name in SWIM_OPTIONS if getattr(args, name) != args.swim_defaults[name]]
     if given:
         raise ConfigError(f"--config repeats the swim as its file describes it: drop {', '.join(given)}")
     command, spec = repeatable(args.config)

@@ -18,7 +18,7 @@ def add_parser(subparsers) -> None:
                           help="drag: towed passive drag vs Narita et al. 2017; sph: the SPH water against "
                                "rho g V, the thin plates and Narita (takes minutes); strokes: every stroke swum and "
                                "measured against real swimmers and issue 36's targets (a few minutes)"
-                               "; added-mass: the plates' added mass (run --added-mass) on springs and pushed, "
+                               "; added-mass: the plates' added mass on springs and pushed, "
                                "against T = 2 pi sqrt((m + m_a) / k)")
     validate.add_argument("--json", action="store_true")
     backend_option(validate)
@@ -27,8 +27,8 @@ def add_parser(subparsers) -> None:
     strokes.add_argument("--settle", type=float, metavar="S", help="seconds left out at the start (default 5)")
     strokes.add_argument("--workers", type=count(1, MAX_WORKERS), help="parallel swims (default 2)")
     strokes.add_argument("--out", help="output folder for report.md, summary.json and the figure (default: none)")
-    strokes.add_argument("--added-mass", action="store_const", const=True,
-                         help="the swims with the plates' added mass (off by default; docs/fluid.md)")
+    strokes.add_argument("--no-added-mass", dest="added_mass", action="store_const", const=False,
+                         help="the swims without the plates' added mass (on by default; docs/fluid.md)")
     strokes.add_argument("--no-progress", action="store_true", help="no progress bar")
     overwrite_option(strokes)
 
@@ -41,7 +41,8 @@ def run(args) -> None:
     from layered_swim.fluid.medium import Medium
     from layered_swim.sim.simulation import GRAVITY_M_S2
 
-    given = [f"--{name.replace('_', '-')}" for name in STROKES_ONLY if getattr(args, name) is not None]
+    given = ["--no-added-mass" if name == "added_mass" else f"--{name.replace('_', '-')}"
+             for name in STROKES_ONLY if getattr(args, name) is not None]
     if args.what == "strokes":
         return _validate_strokes(args)
     if given:
@@ -74,7 +75,7 @@ def _validate_strokes(args) -> None:
     out = out_dir(args, None) if args.out is not None else None
     seconds = stroke_validation.DEFAULT_SECONDS if args.seconds is None else args.seconds
     configs = stroke_validation.validation_configs(seconds, SETTLE_S if args.settle is None else args.settle,
-                                                   plate={"added_mass": True} if args.added_mass else None)
+                                                   plate={"added_mass": False} if args.added_mass is False else None)
     folder = claim(out) if out is not None else None      # everything checked: now the folder is ours
     report = stroke_validation.validate_strokes(configs, args.workers or DEFAULT_WORKERS,
                                                 folder / "cache" if folder else None,

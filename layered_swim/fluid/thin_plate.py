@@ -4,7 +4,7 @@ Flow at the swimmer = uniform current + Yang's swimmer-induced flow (eq. 5) driv
 whole-body centre-of-mass velocity and the pelvis long axis. Hydrodynamic forces come from
 the per-face plate kernel, buoyancy from the exact ellipsoid kernel. All three run in one
 compiled call per step: called one by one from Python, their call overheads cost as much as
-their arithmetic. With ``added_mass`` (off by default) each segment also carries the water it
+their arithmetic. With ``added_mass`` (on by default) each segment also carries the water it
 accelerates (``added_mass.py``): a second compiled call, with one step of memory.
 """
 from __future__ import annotations
@@ -49,9 +49,8 @@ class PlateSettings:
     exact_buoyancy: bool = True
     patches_per_edge: int = 1      # >= 2 resolves a spinning segment's rotational drag (plate.py)
     # Each segment's added mass and inertia (its ellipsoid's, Lamb), opposing its acceleration,
-    # semi-implicit (added_mass.py). Off until the strokes are re-authored for it: every published
-    # number is of swims without it.
-    added_mass: bool = False
+    # semi-implicit (added_mass.py): the unsteady force SWUM includes and Yang's plates lack.
+    added_mass: bool = True
 
     def __post_init__(self):
         for name in ("r_min", "r_max"):

@@ -120,6 +120,9 @@ class World:
         self.segment_links = [-1] + [names[s] for s in body.segment_names[1:]]
         for link in [-1, *range(n_joints)]:
             c.setCollisionFilterGroupMask(self.uid, link, 0, 0)   # open water: no contacts at all
+            # PyBullet damps every link's velocity over the ground (0.04 by default): a drag the water
+            # does not exert, which also made a uniform current change the speed through the water.
+            c.changeDynamics(self.uid, link, linearDamping=0.0, angularDamping=0.0)
         # PyBullet's default joint motors would fight the PD torques: switch them off.
         for j in range(n_joints):
             if c.getJointInfo(self.uid, j)[2] == pybullet.JOINT_SPHERICAL:
