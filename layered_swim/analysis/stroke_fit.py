@@ -54,7 +54,7 @@ from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, Strict, between, file_path, load_yaml, parse, read_text, search_dirs
 from layered_swim.control.calibration import SEQUENCE_AXIS
 from layered_swim.control.stroke import stroke_path
-from layered_swim.outputs import atomic_path, write_json, write_text
+from layered_swim.outputs import atomic_path, write_json
 from layered_swim.sim.simulation import SimulationDiverged
 
 HISTORY = "history.jsonl"
@@ -368,8 +368,8 @@ class Search:
         self.names = list(spec.knobs)
         self.low = np.array([spec.knobs[n].min for n in self.names])
         self.high = np.array([spec.knobs[n].max for n in self.names])
-        start = np.clip((self.start_values() - self.low) / (self.high - self.low), 0.0, 1.0)
-        self.es = cma.CMAEvolutionStrategy(start.tolist(), spec.sigma, {
+        self.start_x = np.clip((self.start_values() - self.low) / (self.high - self.low), 0.0, 1.0)
+        self.es = cma.CMAEvolutionStrategy(self.start_x.tolist(), spec.sigma, {
             "bounds": [0.0, 1.0], "popsize": spec.population, "seed": spec.seed, "verbose": -9})
         self.history: list[dict] = []
 
@@ -465,7 +465,7 @@ def fit(spec: FitSpec, stroke: dict, stroke_text: str, out: Path, workers: int =
     with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool, \
             tqdm(total=spec.generations, initial=done, desc="generations", disable=not progress) as bar:
         if not search.history:      # generation 0: the stroke as it is
-            _record(search, out, key, 0, [None], [search.knob_values(_start_x(search))], swim_all)
+            _record(search, out, key, 0, [None], [search.knob_values(search.start_x)], swim_all)
         for generation in range(done + 1, spec.generations + 1):
             xs = search.ask()
             scores = _record(search, out, key, generation, xs, [search.knob_values(x) for x in xs], swim_all)
@@ -479,10 +479,6 @@ def fit(spec: FitSpec, stroke: dict, stroke_text: str, out: Path, workers: int =
     return {"out": str(out), "generations": spec.generations, "start": search.history[0]["scores"][0],
             "best": best, "held": [n for n, m in best["misses"].items() if m == 0.0],
             "missed": [n for n, m in best["misses"].items() if m != 0.0]}
-
-
-def _start_x(search: Search) -> np.ndarray:
-    return np.clip((search.start_values() - search.low) / (search.high - search.low), 0.0, 1.0)
 
 
 def _record(search: Search, out: Path, key: str, generation: int, xs, knobs: list[dict], swim_all) -> list[float]:
@@ -523,7 +519,3 @@ def report(result: dict, spec: FitSpec) -> str:
         wanted = f"{'' if target.min is None else f'{target.min:g}'}..{'' if target.max is None else f'{target.max:g}'}"
         lines.append(f"  {'✔' if best['misses'][name] == 0.0 else '✘'} {name} {shown} (wanted {wanted})")
     return "\n".join(lines)
-
-
-def write_report(out: Path, text: str) -> None:
-    write_text(out / "report.txt", text + "\n")

@@ -25,7 +25,7 @@ def add_parser(subparsers) -> None:
 def run(args) -> None:
     from layered_swim.analysis import stroke_fit
     from layered_swim.config import ConfigError, read_text
-    from layered_swim.outputs import claim
+    from layered_swim.outputs import claim, write_text
 
     try:
         import cma  # noqa: F401
@@ -38,5 +38,5 @@ def run(args) -> None:
     result = stroke_fit.fit(spec, stroke, read_text(source), path, workers=args.workers, resume=args.resume,
                             progress=progress(args), say=say)
     text = stroke_fit.report(result, spec)
-    stroke_fit.write_report(path, text)
+    write_text(path / "report.txt", text + "\n")
     print(json.dumps(result, allow_nan=False) if args.json else text)

@@ -96,6 +96,11 @@ def added_mass_option(command: argparse.ArgumentParser) -> None:
                          help="leave out the water each segment carries (plate backend; on by default; docs/fluid.md)")
 
 
+def flag(name: str) -> str:
+    """The command-line flag that sets ``args.<name>`` (for errors that name what was given)."""
+    return "--no-added-mass" if name == "added_mass" else f"--{name.replace('_', '-')}"
+
+
 def plate_fields(args) -> dict | None:
     """``SwimSpec.plate`` from the command line: None (the plates' defaults) but with --no-added-mass."""
     return {"added_mass": False} if not getattr(args, "added_mass", True) else None

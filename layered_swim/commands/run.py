@@ -9,6 +9,7 @@ from layered_swim.commands.export import export_option, export_swim, export_targ
 from layered_swim.commands.options import (
     added_mass_option,
     backend_option,
+    flag,
     medium,
     out_dir,
     overwrite_option,
@@ -63,8 +64,7 @@ def _repeat(args) -> None:
     from layered_swim.outputs import check_out_dir
     from layered_swim.runs import default_out_dir, follow_run, goal_run, repeatable, run_swim
 
-    given = ["--no-added-mass" if name == "added_mass" else f"--{name.replace('_', '-')}"
-             for name in SWIM_OPTIONS if getattr(args, name) != args.swim_defaults[name]]
+    given = [flag(name) for name in SWIM_OPTIONS if getattr(args, name) != args.swim_defaults[name]]
     if given:
         raise ConfigError(f"--config repeats the swim as its file describes it: drop {', '.join(given)}")
     command, spec = repeatable(args.config)

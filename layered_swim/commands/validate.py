@@ -6,7 +6,15 @@ import argparse
 import json
 import sys
 
-from layered_swim.commands.options import MAX_WORKERS, backend_option, count, fluid_settings, out_dir, overwrite_option
+from layered_swim.commands.options import (
+    MAX_WORKERS,
+    backend_option,
+    count,
+    flag,
+    fluid_settings,
+    out_dir,
+    overwrite_option,
+)
 from layered_swim.commands.tables import fmt, table
 
 STROKES_ONLY = ("seconds", "settle", "workers", "out", "added_mass")      # options of `validate strokes` alone
@@ -41,8 +49,7 @@ def run(args) -> None:
     from layered_swim.fluid.medium import Medium
     from layered_swim.sim.simulation import GRAVITY_M_S2
 
-    given = ["--no-added-mass" if name == "added_mass" else f"--{name.replace('_', '-')}"
-             for name in STROKES_ONLY if getattr(args, name) is not None]
+    given = [flag(name) for name in STROKES_ONLY if getattr(args, name) is not None]
     if args.what == "strokes":
         return _validate_strokes(args)
     if given:
