@@ -38,7 +38,7 @@ from layered_swim.config import ConfigError, load
 from layered_swim.control.auto import AUTO, AUTO_STROKES, AutoStrokeController
 from layered_swim.control.basic import StrokeController
 from layered_swim.control.calibration import load_table
-from layered_swim.control.cycle_choice import TargetChooser, TempoControl
+from layered_swim.control.cycle_choice import Lead, TargetChooser, TempoControl
 from layered_swim.control.layered import CycleChooser, LayeredController, Layers, fixed_weights
 from layered_swim.control.lungs import LungControl
 from layered_swim.control.rules import arm_indices
@@ -212,14 +212,21 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
     if weights is None:
         steer = stroke.steering
         if layers.cycle:
-            pace = tempo_control or TempoControl(min_tempo=steer.min_tempo, glide_within_m=steer.glide_within_m,
-                                                 wide_turn_rad=math.radians(steer.wide_turn_deg))
+            # A task with its own tempo control (the goal line) keeps the default aim too: the
+            # shipped residual was trained on it.
+            pace, lead = tempo_control, Lead()
+            if tempo_control is None:
+                pace = TempoControl(min_tempo=steer.min_tempo, glide_within_m=steer.glide_within_m,
+                                    glide_cycles=steer.glide_cycles, turn_tempo=steer.turn_tempo,
+                                    turn_tempo_until_ahead_s=steer.turn_tempo_until_ahead_s,
+                                    wide_turn_rad=math.radians(steer.wide_turn_deg))
+                lead = Lead(bend_s=steer.lead_bend_s, wait_ahead_s=steer.wait_ahead_s)
             gains = SteeringGains(steer.yaw_fraction, steer.pitch_fraction, steer.roll_fraction,
                                   over_weight_within_rad=math.radians(steer.over_weight_within_deg))
             level_off = (math.radians(steer.level_off_beyond_deg)
                          if LEVEL_OFF in stroke.perturbations and lying(stroke.start.posture) else None)
             weights = TargetChooser(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,
-                                    level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo)
+                                    lead=lead, level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo)
         else:
             weights = fixed_weights({}, tempo=tempo)
     lungs = LungControl(body.lung_air_l, body.max_lung_air_l) if stroke.steering.breathe else None

@@ -27,6 +27,7 @@ from layered_swim.control.stroke import (
 from layered_swim.control.targets import FixedTarget, TrajectoryTarget, load_trajectory
 from layered_swim.episode import Episode
 from layered_swim.sim.simulation import PRONE_QUAT_XYZW
+from layered_swim.spec import GOAL_TEMPO
 from layered_swim.state import BodyState, Segments
 from layered_swim.tasks import FollowTarget
 
@@ -133,6 +134,41 @@ def test_glide_holds_the_pose_but_the_joints_that_keep_moving():
     assert np.ptp(running[moving]) > 0.05     # they do move
 
 
+def test_a_short_glide_ends_its_cycle_early():
+    """A glide of a third of a cycle (the crawl's: one beat of its kick) hands over to the next
+    cycle after period/3 at tempo 1, and that cycle starts there."""
+    stroke = load_stroke("front_crawl", LAYOUT)
+    choices = iter([CycleChoice(glide=True, cycles=1 / 3), CycleChoice()])
+    controller = LayeredController(stroke, LAYOUT, arm_indices(BODY, LAYOUT), lambda *_: next(choices),
+                                   Layers(cycle=True, palm=False, reach=False))
+    state = still_state()
+    controller.desired(0.0, state, np.zeros((16, 3)))
+    assert controller.choice.glide and not controller.cycle_ends(0.33 * stroke.period_s)
+    assert controller.cycle_ends(0.34 * stroke.period_s)
+    state.time_s = 0.34 * stroke.period_s
+    controller.desired(state.time_s, state, np.zeros((16, 3)))
+    assert controller.cycle == 1 and not controller.choice.glide
+    assert controller.cycle_start_s == pytest.approx(stroke.period_s / 3)
+
+
+def test_turning_toward_a_target_off_the_heading_swims_at_the_turn_tempo():
+    """Behind a target 90 deg off to the left, a stroke with turn_tempo 1.2 swims at 1.2 (by
+    default none: the tempo it has anyway); with the target ahead, or once ahead of it along its path by
+    more than turn_tempo_until_ahead_s, at the tempo it would have anyway."""
+    turning = TempoControl(turn_tempo=1.2, turn_tempo_until_ahead_s=0.5)
+    assert turning.turning_tempo(0.8, math.radians(90.0), -1.0) == pytest.approx(1.2)
+    assert turning.turning_tempo(0.8, math.radians(90.0), 0.5) == pytest.approx(1.2)
+    assert turning.turning_tempo(0.8, math.radians(90.0), 0.6) == pytest.approx(0.8)
+    assert turning.turning_tempo(0.8, math.radians(20.0), -1.0) == pytest.approx(0.8)
+    assert TempoControl().turning_tempo(0.8, math.radians(90.0), -1.0) == pytest.approx(0.8)
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
+    left = FixedTarget((0.0, 3.0, 0.0))
+    assert TargetChooser(left, table(), "prone", tempo=turning)(0, state, 0.0).tempo == pytest.approx(1.2)
+    assert TargetChooser(left, table(), "prone")(0, state, 0.0).tempo == pytest.approx(TempoControl().min_tempo)
+    ahead = TargetChooser(FixedTarget((3.0, 0.0, 0.0)), table(), "prone", tempo=turning)(0, state, 0.0)
+    assert ahead.tempo == pytest.approx(1.0)
+
+
 def test_steering_settings_come_from_the_stroke_file_and_leave_its_calibration_fresh():
     crawl = Episode("front_crawl", FollowTarget(FixedTarget([5.0, 0.0, -0.3])))
     crawl.close()
@@ -140,7 +176,17 @@ def test_steering_settings_come_from_the_stroke_file_and_leave_its_calibration_f
     gains = crawl.controller.chooser.gains
     assert (gains.yaw_fraction, gains.pitch_fraction, gains.roll_fraction) == (
         steering.yaw_fraction, steering.pitch_fraction, steering.roll_fraction)
-    assert crawl.controller.chooser.tempo_control.min_tempo == steering.min_tempo
+    pace = crawl.controller.chooser.tempo_control
+    assert (pace.min_tempo, pace.glide_cycles, pace.turn_tempo, pace.turn_tempo_until_ahead_s) == (
+        steering.min_tempo, steering.glide_cycles, steering.turn_tempo, steering.turn_tempo_until_ahead_s)
+    lead = crawl.controller.chooser.lead
+    assert (lead.bend_s, lead.wait_ahead_s) == (steering.lead_bend_s, steering.wait_ahead_s) != (
+        Lead().bend_s, Lead().wait_ahead_s)
+    # A task with its own tempo control (the goal, on which the shipped residual was trained) keeps
+    # the default aim.
+    goal = Episode("front_crawl", FollowTarget(FixedTarget([5.0, 0.0, -0.3])), tempo_control=GOAL_TEMPO)
+    goal.close()
+    assert goal.controller.chooser.lead == Lead() and goal.controller.chooser.tempo_control is GOAL_TEMPO
     breast = Episode("breaststroke", FollowTarget(FixedTarget([5.0, 0.0, -0.3])))
     breast.close()
     assert breast.controller.chooser.tempo_control.wide_turn_rad == pytest.approx(math.radians(180.0))
@@ -361,11 +407,12 @@ def test_a_swimmer_ahead_of_its_target_waits_for_it():
     waiting = TargetChooser(behind, table(), "prone")(0, state, 0.0)
     assert (not waiting.glide and waiting.thrust_demand == 0.0
             and waiting.tempo == pytest.approx(TempoControl().min_tempo))
-    gliding = TargetChooser(behind, table(), "prone", tempo=TempoControl(glide_within_m=0.6))(0, state, 0.0)
-    assert gliding.glide       # a stroke that glides to wait (the crawl) glides
+    gliding = TargetChooser(behind, table(), "prone", tempo=TempoControl(glide_within_m=0.6, glide_cycles=0.5))(
+        0, state, 0.0)
+    assert gliding.glide and gliding.cycles == 0.5      # a stroke that glides to wait (the crawl) glides
     ahead = TrajectoryTarget(np.array([[2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 18.0]), 0.5, False)
     chasing = TargetChooser(ahead, table(), "prone")(0, state, 0.0)
-    assert not chasing.glide and chasing.thrust_demand == pytest.approx(1.0)
+    assert not chasing.glide and chasing.cycles == 1.0 and chasing.thrust_demand == pytest.approx(1.0)
 
 
 def test_a_gliding_stroke_near_its_target_glides_only_once_ahead_of_it_along_its_path():

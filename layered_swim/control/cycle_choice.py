@@ -29,11 +29,21 @@ class TempoControl:
     ``min_tempo`` while the target is more than ``wide_turn_rad`` off the heading (swimming slower
     tightens the turn: speed falls faster than the turn rate). With ``keep_pace``, never slower
     than the tempo whose steady speed (the calibration's pace) is a moving target's own, unless
-    ahead of it: slowing below it near the target only let it get away again."""
+    ahead of it: slowing below it near the target only let it get away again.
+
+    ``turn_tempo``: at least this tempo while the target is more than ``easy_turn_rad`` off the
+    heading and the swimmer is at most ``turn_tempo_until_ahead_s`` ahead of it along its path (a
+    stroke whose turn per cycle holds as its tempo rises turns more per second: the re-authored
+    crawl and breaststroke, whose slow cycles could not follow the figure-eight's bends). A glide
+    lasts ``glide_cycles`` of a cycle: a crawl's kick keeps it moving through a glide, and a
+    whole cycle of it overshot a slow target."""
 
     min_tempo: float = 0.5
     keep_pace: bool = True
     glide_within_m: float = 0.0
+    glide_cycles: float = 1.0
+    turn_tempo: float | None = None
+    turn_tempo_until_ahead_s: float = 0.0
     near_m: float = 0.2
     far_m: float = 0.6
     easy_turn_rad: float = math.radians(30.0)
@@ -47,6 +57,12 @@ class TempoControl:
 
     def tempo_for(self, drive: float) -> float:
         return float(self.min_tempo + (1.0 - self.min_tempo) * drive)
+
+    def turning_tempo(self, tempo: float, heading_error_rad: float, ahead_of_target_s: float) -> float:
+        if (self.turn_tempo is not None and abs(heading_error_rad) > self.easy_turn_rad
+                and ahead_of_target_s <= self.turn_tempo_until_ahead_s):
+            return max(tempo, self.turn_tempo)
+        return tempo
 
 
 STEP_S = 0.5    # the target's direction and speed are read from its move over this long
@@ -63,7 +79,7 @@ class Lead:
     a long one starts the turn early, as turning takes cycles."""
 
     straight_s: float = 1.5
-    bend_s: float = 3.0
+    bend_s: float = 3.0         # strokes set their own (``steering.lead_bend_s``): the turns they can make
     full_bend_rad: float = math.radians(60.0)   # the path's change of direction over bend_s that earns all of it
     search_s: float = 6.0       # how far along the path, either way from the target, to look for the swimmer
     wait_ahead_s: float = 0.5   # ahead of the target by more than this along its path: slow down
@@ -143,6 +159,8 @@ class TargetChooser:
         if self.tempo_control.keep_pace and not waiting and foresight:
             speed_m_s = target_speed_m_s(self.target, state.time_s + max(0.0, ahead_of_target_s), STEP_S)
             tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(speed_m_s)))
+        if not waiting:
+            tempo = self.tempo_control.turning_tempo(tempo, heading_error, ahead_of_target_s)
         self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains,
                                         self.table.pace.roll_at(tempo))
         near = (distance < self.tempo_control.glide_within_m
@@ -157,4 +175,5 @@ class TargetChooser:
             weights[LEVEL_OFF] = 1.0
         # Near the target, or turning hard, the rules stop seeking more thrust (Yang 4.4: more force
         # only where more is wanted); else they speed the swimmer past a slow target.
-        return CycleChoice(weights, tempo, glide, thrust_demand=drive)
+        return CycleChoice(weights, tempo, glide, self.tempo_control.glide_cycles if glide else 1.0,
+                           thrust_demand=drive)

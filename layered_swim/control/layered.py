@@ -56,7 +56,8 @@ class CycleChoice:
 
     weights: dict[str, float] = field(default_factory=dict)
     tempo: float = 1.0
-    glide: bool = False      # hold the cycle's first pose for one period (but the stroke's glide_moving_joints)
+    glide: bool = False      # hold the cycle's first pose (but the stroke's glide_moving_joints)
+    cycles: float = 1.0      # how much of a stroke cycle this choice lasts (a glide may be shorter)
     thrust_demand: float = 1.0   # 0..1: how much more force the rules should seek this cycle
 
 
@@ -98,7 +99,7 @@ class LayeredController:
 
     def cycle_ends(self, time_s: float) -> bool:
         """Whether the cycle under way is over at ``time_s`` (or none has begun)."""
-        return self.cycle < 0 or (time_s - self.cycle_start_s) * self.cycles_per_s >= 1.0
+        return self.cycle < 0 or (time_s - self.cycle_start_s) * self.cycles_per_s >= self.choice.cycles
 
     @property
     def cycles_per_s(self) -> float:
@@ -113,7 +114,7 @@ class LayeredController:
 
     def _start_cycle(self, state: BodyState | None) -> None:
         if self.cycle >= 0:
-            self.cycle_start_s += 1.0 / self.cycles_per_s
+            self.cycle_start_s += self.choice.cycles / self.cycles_per_s
         self.cycle += 1
         if self._roll_n:
             self.last_mean_roll_rad = self._roll_sum / self._roll_n

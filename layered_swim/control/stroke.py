@@ -93,15 +93,24 @@ class RulesSpec(Strict):
 
 class SteeringSpec(Strict):
     """How the per-cycle layer steers this stroke: the share of each error it corrects in one
-    cycle, tempo down to ``min_tempo`` (below it the stroke stops working), and gliding for a
-    cycle when closer than ``glide_within_m``, with ``glide_moving_joints`` still stroking
-    (a crawl's legs keep kicking in a glide, or they sink)."""
+    cycle, tempo down to ``min_tempo`` (below it the stroke stops working) or up to ``turn_tempo``
+    in a turn, and gliding for ``glide_cycles`` when closer than ``glide_within_m``, with
+    ``glide_moving_joints`` still stroking (a crawl's legs keep kicking in a glide, or they sink)."""
 
     yaw_fraction: float = Field(SteeringGains.yaw_fraction, ge=0.0, le=1.0)
     pitch_fraction: float = Field(SteeringGains.pitch_fraction, ge=0.0, le=1.0)
     roll_fraction: float = Field(SteeringGains.roll_fraction, ge=0.0, le=1.0)
     min_tempo: float = Field(0.5, ge=0.1, le=1.0)
     glide_within_m: float = Field(0.0, ge=0.0, le=10.0)
+    glide_cycles: float = Field(1.0, gt=0.0, le=1.0)     # a glide's length in cycles
+    # At least this tempo while turning more than 30 deg toward a target, unless more than
+    # turn_tempo_until_ahead_s ahead of a moving one along its path (none: the tempo it has anyway).
+    turn_tempo: float | None = Field(None, ge=0.5, le=1.5)
+    turn_tempo_until_ahead_s: float = Field(0.0, ge=-10.0, le=10.0)
+    # On a moving target's known path: aim this far ahead where it bends (1.5 s where it runs
+    # straight), and wait (slowest tempo, or glide) when more than wait_ahead_s ahead of it.
+    lead_bend_s: float = Field(3.0, ge=1.5, le=10.0)
+    wait_ahead_s: float = Field(0.5, ge=0.0, le=10.0)
     glide_moving_joints: list[str] = []
     # The largest weight the per-cycle layer gives a sequence (its offsets times this; the pose stays
     # inside the joints' ranges); `calibrate` measures turns up to it.
