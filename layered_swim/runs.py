@@ -17,7 +17,6 @@ import subprocess
 import sys
 import time
 import warnings
-from dataclasses import asdict
 from importlib import metadata
 from pathlib import Path
 
@@ -60,7 +59,7 @@ def resolved_config(episode: Episode, spec: SwimSpec, command: str, **extra) -> 
         "stroke": episode.stroke_spec.model_dump(mode="json"),
         "body_file": sim.body.source,
         "lung_air_l": sim.body.lung_air_l,
-        "medium": asdict(sim.fluid.medium),
+        "medium": sim.fluid.medium.to_json(),
         "fluid_backend": {"name": sim.fluid.name, "settings": sim.fluid.settings()},
         "gravity_m_s2": sim.config.gravity_m_s2,
         "physics_hz": sim.config.physics_hz,
@@ -282,8 +281,9 @@ def follow_run(spec: SwimSpec, out_dir: OutputFolder | str | Path | None = None,
     observers = [] if steering is None else [steering.driver(episode)]
     head = {"trajectory": target.name, "stroke": spec.stroke,
             "layers": (spec.layer_set if steering is None else steering.layers).describe(),
-            "current_m_s": list(spec.medium.current_m_s), "seconds": spec.seconds, "seed": spec.seed,
-            **({} if steering is None else steering.summary)}
+            "current_m_s": list(spec.medium.current_m_s),
+            **({"water": spec.medium.flow.name} if spec.medium.flow else {}),
+            "seconds": spec.seconds, "seed": spec.seed, **({} if steering is None else steering.summary)}
     if out_dir is None:
         swim(episode, spec.seconds, observers)
         return {**head, **episode.metrics(), **fluid_report(episode)}

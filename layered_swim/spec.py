@@ -18,6 +18,7 @@ from layered_swim.config import ConfigError, Strict, between, parse
 from layered_swim.control.cycle_choice import TempoControl
 from layered_swim.control.layered import Layers
 from layered_swim.episode import START_JITTER, WIDE_JITTER, Episode
+from layered_swim.fluid.flow_field import FlowField, WaterSpec
 from layered_swim.fluid.medium import Medium, water
 from layered_swim.recorder import DEFAULT_LOG_HZ
 from layered_swim.sim.simulation import PHYSICS_HZ
@@ -33,14 +34,17 @@ Speed_m_s = between(-5.0, 5.0)
 
 
 class MediumSpec(Strict):
-    """The water: a preset (its density and viscosity), optionally another density, a current."""
+    """The water: a preset (its density and viscosity), optionally another density, a current, and
+    a flow field (a ``water`` file's content, kept whole so the run replays without the file)."""
 
     fluid: Literal["fresh_water", "seawater"] = "fresh_water"
     density_kg_m3: between(1.0, 20000.0) | None = None
     current_m_s: tuple[Speed_m_s, Speed_m_s, Speed_m_s] = (0.0, 0.0, 0.0)
+    flow: WaterSpec | None = None
 
     def medium(self) -> Medium:
-        return water(self.fluid, self.density_kg_m3, self.current_m_s)
+        return water(self.fluid, self.density_kg_m3, self.current_m_s,
+                     FlowField(self.flow) if self.flow is not None else None)
 
 
 class FreeSwimTask(Strict):

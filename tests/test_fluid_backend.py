@@ -54,4 +54,4 @@ def test_unknown_backend_is_a_one_line_config_error():
 
 
 def test_the_water_holds_only_what_water_is():
-    assert set(Medium.__dataclass_fields__) == {"rho_kg_m3", "eta_pa_s", "surface_z_m", "current_m_s"}
+    assert set(Medium.__dataclass_fields__) == {"rho_kg_m3", "eta_pa_s", "surface_z_m", "current_m_s", "flow"}

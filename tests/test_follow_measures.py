@@ -14,7 +14,7 @@ from layered_swim.control.cycle_choice import TargetChooser
 from layered_swim.control.targets import StationTarget
 from layered_swim.episode import START_JITTER, WIDE_JITTER, jittered_start
 from layered_swim.state import Start
-from layered_swim.tasks.follow import hold_depth, station_metrics
+from layered_swim.tasks.follow import hold_depth, station_metrics, stroke_spells
 
 
 def test_depth_is_checked_only_while_the_target_holds_one():
@@ -85,3 +85,17 @@ def test_follow_seeds_reports_medians_over_perturbed_starts(tmp_path):
     refused = subprocess.run([sys.executable, "-m", "layered_swim", "follow", "jumping", "--seconds", "1",
                               "--seeds", "2", "--backend", "sph"], capture_output=True, text=True, timeout=300)
     assert refused.returncode == 2 and refused.stderr.count("\n") == 1 and "--seeds" in refused.stderr
+
+
+def test_the_summary_says_which_stroke_swam_when():
+    """``auto`` switching breaststroke -> treading water -> breaststroke: three spells, each from its
+    first sample to the next spell's first (the last to the run's last sample)."""
+    time_s = np.arange(8) * 0.5
+    strokes = np.array(["breaststroke"] * 3 + ["treading_water"] * 4 + ["breaststroke"])
+    assert stroke_spells(time_s, strokes) == [
+        {"stroke": "breaststroke", "from_s": 0.0, "to_s": 1.5},
+        {"stroke": "treading_water", "from_s": 1.5, "to_s": 3.5},
+        {"stroke": "breaststroke", "from_s": 3.5, "to_s": 3.5}]
+    assert stroke_spells(time_s[:2], np.array(["front_crawl"] * 2)) == [
+        {"stroke": "front_crawl", "from_s": 0.0, "to_s": 0.5}]
+    assert stroke_spells(np.array([]), np.array([])) == []

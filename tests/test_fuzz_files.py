@@ -19,10 +19,11 @@ from layered_swim.config import ConfigError
 from layered_swim.control.calibration import load_table
 from layered_swim.control.stroke import STROKES_DIR, load_stroke
 from layered_swim.control.targets import TRAJECTORIES_DIR, load_trajectory
+from layered_swim.fluid.flow_field import WATER_DIR, load_water
 from layered_swim.recorder import read_log
 from layered_swim.render.replay import LogReplay
 
-EXAMPLES = 90         # per file kind; six kinds: 540 cases
+EXAMPLES = 90         # per file kind; seven kinds: 630 cases
 FUZZ = settings(max_examples=EXAMPLES, deadline=None, derandomize=True,
                 suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 LAYOUT = joint_layout(load_body())
@@ -119,6 +120,19 @@ def test_trajectory_files(data, folder):
     if target is not None:
         points = np.array([target.position(t) for t in (0.0, 1.0, 60.0, 3600.0)])
         assert np.isfinite(points).all() and np.abs(points).max() < 1e6
+
+
+@given(data=st.data())
+@FUZZ
+def test_water_files(data, folder):
+    name = data.draw(st.sampled_from(sorted(p.name for p in WATER_DIR.glob("*.yaml"))))
+    path = folder / "water.yaml"
+    path.write_bytes(_file_text(data.draw, (WATER_DIR / name).read_text()))
+    flow = loads_or_one_line(lambda: load_water(path))
+    if flow is not None:
+        points = np.array([[0.0, 0.0, -0.3], [5.0, 2.5, 0.0], [1e3, -1e3, -50.0]])
+        velocity = np.concatenate([flow.velocity_m_s(points, t) for t in (0.0, 1.0, 3600.0)])
+        assert np.isfinite(velocity).all() and np.abs(velocity).max() < 1e3
 
 
 @given(data=st.data())

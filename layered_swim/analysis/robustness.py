@@ -52,7 +52,8 @@ def follow_seeds(spec: SwimSpec, seeds: int = 10, out_dir: OutputFolder | str | 
     layers = spec.layer_set if steering is None else steering.layers
     common = {"trajectory": spec.task.trajectory, "stroke": spec.stroke, "layers": layers.describe(),
               "current_m_s": list(spec.medium.current_m_s), "density_kg_m3": spec.medium.density_kg_m3,
-              "seconds": spec.seconds, **({"policy": spec.policy} if spec.policy else {})}
+              "seconds": spec.seconds, **({"policy": spec.policy} if spec.policy else {}),
+              **({"water": spec.medium.flow.name} if spec.medium.flow else {})}
     configs = [spec.with_(seed=seed, jitter="wide").model_dump(mode="json") for seed in range(1, seeds + 1)]
     out = None
     if out_dir is not None:       # the first start checked here (files, stroke, path), then the folder claimed

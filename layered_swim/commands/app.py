@@ -58,7 +58,7 @@ def run(args) -> None:
 
         policy = ResidualPolicy.load(args.policy)
     session = SwimSession(args.stroke, Layers.parse(args.layers), vector(args.current, "--current"), args.density,
-                          args.trajectory, policy=policy)
+                          args.trajectory, policy=policy, water=args.water)
     if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         session.close()
         raise ConfigError("no display to open a window on (run it on a desktop, or under xvfb-run); "

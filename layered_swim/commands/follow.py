@@ -56,6 +56,8 @@ def run(args) -> None:
         print(json.dumps({**result, "out_dir": str(out.path)}, allow_nan=False))
         return
     rows = {k: v for k, v in result.items() if not isinstance(v, dict)}
+    rows["strokes_swum"] = ", ".join(f"{spell['stroke']} {spell['from_s']:.1f}-{spell['to_s']:.1f} s"
+                                     for spell in result["strokes_swum"])
     rows.update({f"swim.{k}": v for k, v in result.get("swim_metrics", {}).items() if v is not None})
     print(table([[k, fmt(v)] for k, v in rows.items()]))
     print(f"\nwrote summary.json, config.json, track.npz, log.npz, timeseries.csv to {out.path}")

@@ -70,10 +70,13 @@ def _spec(args, stroke: str):
 def _goal_policy(args) -> None:
     import numpy as np
 
+    from layered_swim.config import ConfigError
     from layered_swim.rl.policy import ResidualPolicy, evaluate_goals
     from layered_swim.runs import goal_run
     from layered_swim.tasks.goal import GOAL_METRICS
 
+    if args.water:
+        raise ConfigError("--water with --policy: the policy's environment takes a uniform --current only")
     policy = ResidualPolicy.load(args.policy)
     policy.check_stroke(args.stroke)
     stroke, current = policy.env.stroke, vector(args.current, "--current")

@@ -126,20 +126,34 @@ def swim_spec(args, stroke: str, task: dict, **fields):
 
 
 def medium(args, current: bool = True) -> dict:
-    """``SwimSpec.medium`` from --fluid, --density and --current (those the command has)."""
+    """``SwimSpec.medium`` from --fluid, --density, --current and --water (those the command has)."""
     water = {"fluid": getattr(args, "fluid", None), "density_kg_m3": getattr(args, "density", None),
-             "current_m_s": vector(args.current, "--current") if current and hasattr(args, "current") else None}
+             "current_m_s": vector(args.current, "--current") if current and hasattr(args, "current") else None,
+             "flow": flow_spec(args)}
     return {k: v for k, v in water.items() if v is not None}
+
+
+def flow_spec(args) -> dict | None:
+    """The --water file's content (checked), or None without one."""
+    from layered_swim.fluid.flow_field import load_water
+
+    return load_water(args.water).to_json() if getattr(args, "water", None) else None
 
 
 def current_option(command: argparse.ArgumentParser) -> None:
     command.add_argument("--current", default="0,0,0", metavar="X,Y,Z", help="uniform current in m/s")
 
 
+def water_option(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--water", metavar="FILE", help="a flow field: a water file's name (see water/) or path "
+                                                         "(sources, sinks, vortices, waves), added to --current")
+
+
 def steering_options(command: argparse.ArgumentParser, density: bool = True) -> None:
     """The options of a swim toward a target: layers, current and (optionally) density; the app has them too."""
     command.add_argument("--layers", default="basic,cycle,rules", help="basic[,cycle][,rules|palm|reach]")
     current_option(command)
+    water_option(command)
     if density:
         command.add_argument("--density", type=float, metavar="KG_M3", help="water density (default fresh water)")
 

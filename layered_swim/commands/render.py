@@ -52,7 +52,8 @@ def run(args) -> None:
     result = render(args.source, args.out, args.seconds, args.fps, size(args.size), args.stroke,
                     Layers.parse(args.layers), vector(args.current, "--current"), args.density, args.forces,
                     progress=progress(args), backend=args.backend, fluid_settings=fluid_settings(args),
-                    overwrite=args.overwrite, camera=args.camera, show_flow=args.flow, frame_s=args.frame)
+                    overwrite=args.overwrite, camera=args.camera, show_flow=args.flow, frame_s=args.frame,
+                    water=args.water)
     if not result["video"] and Path(args.out).suffix.lower() == ".mp4":
         print(f"{PROG}: note: {result['note']}", file=sys.stderr)
     frames = result["frames"]

@@ -14,6 +14,7 @@ from layered_swim.commands.options import (
     out_dir,
     overwrite_option,
     swim_spec,
+    water_option,
     water_options,
 )
 from layered_swim.commands.tables import flat, fmt, table
@@ -38,6 +39,7 @@ def add_parser(subparsers) -> None:
     command.add_argument("--lung-volume", type=float, dest="lung_air_l", metavar="L",
                          help="inhaled air in litres, on top of the residual volume (default 3)")
     water_options(command)
+    water_option(command)
     command.add_argument("--tempo", type=float, default=1.0, help="stroke rate multiplier (default 1)")
     backend_option(command)
     added_mass_option(command)

@@ -1,7 +1,8 @@
 """The thin-plate fluid backend (``plate``): body state -> one force and one torque per segment.
 
-Flow at the swimmer = uniform current + Yang's swimmer-induced flow (eq. 5) driven by the
-whole-body centre-of-mass velocity and the pelvis long axis. Hydrodynamic forces come from
+Flow at each segment = the water's own motion there (a uniform current, plus a flow field's) +
+Yang's swimmer-induced flow (eq. 5) driven by the whole-body centre-of-mass velocity through the
+water at the centre of mass and the pelvis long axis. Hydrodynamic forces come from
 the per-face plate kernel, buoyancy from the exact ellipsoid kernel. All three run in one
 compiled call per step: called one by one from Python, their call overheads cost as much as
 their arithmetic. With ``added_mass`` (on by default) each segment also carries the water it
@@ -64,7 +65,7 @@ class PlateSettings:
 
 
 @njit(cache=True)
-def _flow_at_swimmer(quat, linvel, mass_fraction, current, r_min, r_max, axial):
+def _induced_at_swimmer(quat, linvel, mass_fraction, current, r_min, r_max, axial):
     com_velocity = np.zeros(3)
     for i in range(linvel.shape[0]):     # a loop: np.dot wants contiguous rows, the state's are views
         for j in range(3):
@@ -72,20 +73,23 @@ def _flow_at_swimmer(quat, linvel, mass_fraction, current, r_min, r_max, axial):
     rows = np.empty(9)
     quat_to_rows(quat[0], rows, False)
     axis = np.array([rows[2], rows[5], rows[8]])   # the pelvis long axis (local z) in world coordinates
-    return current + _induced_flow(com_velocity - current, axis, r_min, r_max, axial)
+    return _induced_flow(com_velocity - current, axis, r_min, r_max, axial)
 
 
 @njit(cache=True)
-def _fluid_wrenches(pos, quat, linvel, angvel, segments, medium, coefficients):
+def _fluid_wrenches(pos, quat, linvel, angvel, segments, medium, coefficients, segment_current):
     """``segments`` (n, 8): half extents, ellipsoid semi-axes, mass fraction, volume; ``medium``:
-    the current, then the scalars in the order PlateFluid._pack packs them; ``coefficients``
-    (3, k): angles, C_L, C_D. Packed so that the per-step call passes seven arguments, not twenty."""
+    the water's velocity at the centre of mass, then the scalars in the order PlateFluid.set_medium
+    packs them; ``coefficients`` (3, k): angles, C_L, C_D; ``segment_current`` (n, 3): the water's
+    own velocity at each segment. Packed so that the per-step call passes eight arguments, not twenty."""
     half, semi, mass_fraction, volume = segments[:, 0:3], segments[:, 3:6], segments[:, 6], segments[:, 7]
     current = medium[0:3]
     r_min, r_max, axial, rho, eta, surface_z, g, exact, patches = medium[3:12]
-    water = _flow_at_swimmer(quat, linvel, mass_fraction, current, r_min, r_max, axial != 0.0)
+    induced = _induced_at_swimmer(quat, linvel, mass_fraction, current, r_min, r_max, axial != 0.0)
     flow = np.empty((pos.shape[0], 3))
-    flow[:] = water
+    for i in range(pos.shape[0]):
+        for j in range(3):
+            flow[i, j] = segment_current[i, j] + induced[j]
     force, torque = _plate_wrenches(pos, quat, linvel, angvel, half, flow, rho, eta, surface_z, coefficients[0],
                                     coefficients[1], coefficients[2], int(patches))
     b_force, b_torque = _buoyancy_wrenches(pos, quat, semi, volume, rho, g, surface_z, exact != 0.0)
@@ -123,6 +127,7 @@ class PlateFluid(FluidBackend):
         self._medium = np.array([*m.current_m_s, s.r_min, s.r_max, s.axial_induced_flow, m.rho_kg_m3,
                                  m.eta_pa_s, m.surface_z_m, abs(self.gravity_m_s2), s.exact_buoyancy,
                                  s.patches_per_edge], dtype=np.float64)
+        self._segment_current = np.ascontiguousarray(np.tile(m.current, (len(self._segments), 1)))
         if self.added_mass is not None:
             self.added_mass.set_density(m.rho_kg_m3)
 
@@ -136,8 +141,11 @@ class PlateFluid(FluidBackend):
     def wrenches(self, state: BodyState) -> FluidWrenches:
         # The kernel returns the four arrays in FluidWrenches' order; wrapping the tuple as it is
         # skips the named constructor's argument handling (this runs every physics step).
+        if self.medium.flow is not None:      # the water moves differently at every segment, and in time
+            self._medium[0:3] = self.medium.current_at(state.com_m, state.time_s)[0]
+            self._segment_current = self.medium.current_at(state.pos_m, state.time_s)
         out = _fluid_wrenches(state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s, self._segments,
-                              self._medium, self._coefficients)
+                              self._medium, self._coefficients, self._segment_current)
         if self.added_mass is None:
             return tuple.__new__(FluidWrenches, out)
         force, torque, flow, buoyancy = out

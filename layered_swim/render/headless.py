@@ -30,7 +30,8 @@ def render(source: str, out: str | Path, seconds: float | None = None, fps: floa
            size_px: tuple[int, int] = (960, 540), stroke: str = "breaststroke", layers: Layers = Layers(),
            current_m_s=(0.0, 0.0, 0.0), density_kg_m3: float | None = None, show_forces: bool = False,
            progress: bool = False, backend: str = "plate", fluid_settings=None, overwrite: bool = False,
-           camera: str = "follow", show_flow: bool = False, frame_s: float | None = None) -> dict:
+           camera: str = "follow", show_flow: bool = False, frame_s: float | None = None,
+           water: str | None = None) -> dict:
     """Every frame of the swim into ``out``; with ``frame_s``, the one moment ``frame_s`` seconds
     in as a PNG (the camera still eases in over the frames before it, as in the video)."""
     if not (math.isfinite(fps) and 1 <= fps <= 120):
@@ -47,7 +48,7 @@ def render(source: str, out: str | Path, seconds: float | None = None, fps: floa
         if Path(out).suffix.lower() != ".png":
             raise ConfigError(f"--frame writes one picture: --out must name a .png file, got {out}")
     frames = _frames(source, seconds, fps, frame_s, stroke, layers, current_m_s, density_kg_m3, backend,
-                     fluid_settings)
+                     fluid_settings, water)
     names, times = next(frames)      # the source read and checked before anything is written
     os.environ["PYGLET_HEADLESS"] = "1"
     import pyglet
@@ -108,10 +109,13 @@ def _times(duration_s: float, fps: float, frame_s: float | None) -> list[float]:
     return [k / fps for k in range(math.ceil(frame_s * fps)) if k / fps < frame_s] + [frame_s]
 
 
-def _frames(source, seconds, fps, frame_s, stroke, layers, current_m_s, density_kg_m3, backend, fluid_settings):
+def _frames(source, seconds, fps, frame_s, stroke, layers, current_m_s, density_kg_m3, backend, fluid_settings,
+            water=None):
     """Yields (segment names, frame times) first, then one Scene per time."""
     path = Path(source)
     if path.is_dir():
+        if water:
+            raise ConfigError("--water swims a trajectory: a run folder replays its own log")
         from layered_swim.render.replay import LogReplay
         replay = LogReplay(path)
         times = _times(replay.duration_s if seconds is None else min(seconds, replay.duration_s), fps, frame_s)
@@ -128,7 +132,7 @@ def _frames(source, seconds, fps, frame_s, stroke, layers, current_m_s, density_
     duration_s = seconds if seconds is not None else frame_s if frame_s is not None else 20.0
     times = _times(duration_s, fps, frame_s)
     session = SwimSession(stroke, layers, current_m_s, density_kg_m3, trajectory=source, backend=backend,
-                          fluid_settings=fluid_settings)
+                          fluid_settings=fluid_settings, water=water)
     try:
         check_path_in_pool(session.episode, session.target, duration_s)
         yield session.sim.body.segment_names, times

@@ -24,7 +24,8 @@ def hud_lines(session: SwimSession, fps: float, recording: str = "") -> list[str
         f"speed       {s.speed_m_s:.2f} m/s    stroke rate {s.stroke_rate_cpm:.0f} /min    phase {s.cycle_phase:.2f}",
         f"weights     {weights}",
         f"layers      basic on  per-cycle {on(layers.cycle)}  palm {on(layers.palm)}  reach {on(layers.reach)}",
-        f"fluid       {density.label} ({density.value:g} kg/m3)    current {current.label}",
+        f"fluid       {density.label} ({density.value:g} kg/m3)    current {current.label}"
+        + (f"    water {s.flow.name}" if s.flow is not None else ""),
         f"target      {target}    distance {s.distance_to_target_m:.2f} m",
         f"time        {s.sim.time_s:6.1f} s    {clock}    {fps:.0f} FPS",
     ]

@@ -154,10 +154,13 @@ class Renderer:
 
 
 def _flow_lines(scene: sc.Scene, current_m_s: np.ndarray) -> list:
-    """The current on a lattice around the swimmer (a small cross where the water is still), and
-    the water velocity at each segment where the fluid reported it (a live swim, not a log)."""
+    """The water's own motion on a lattice around the swimmer (the current, or a water file's flow
+    there; a small cross where the water is still), and the water velocity at each segment where
+    the fluid reported it (a live swim, not a log)."""
     lattice = sc.flow_lattice(scene.centre_of_segments_m)
-    if np.linalg.norm(current_m_s) > 0:
+    if scene.water_at is not None:
+        groups = [(sc.arrow_lines(lattice, sc.FLOW_SCALE_M_PER_M_S * scene.water_at(lattice)), sc.CURRENT_COLOR)]
+    elif np.linalg.norm(current_m_s) > 0:
         groups = [(sc.arrow_lines(lattice, np.tile(sc.FLOW_SCALE_M_PER_M_S * current_m_s, (len(lattice), 1))),
                    sc.CURRENT_COLOR)]
     else:

@@ -6,6 +6,7 @@ turns one into triangles and lines on the GPU.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -72,6 +73,8 @@ class Scene:
     particles_m: np.ndarray | None = None        # (k, 3) water particles (the SPH backend)
     particle_speed_m_s: np.ndarray | None = None  # (k,)
     flow_m_s: np.ndarray | None = None            # (n, 3) water velocity at each segment, as the fluid found it
+    # The water's own velocity at (k, 3) points now, where it varies from place to place (a water file).
+    water_at: Callable[[np.ndarray], np.ndarray] | None = None
 
     @property
     def centre_of_segments_m(self) -> np.ndarray:

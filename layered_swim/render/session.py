@@ -18,6 +18,7 @@ from layered_swim.control.steering import attitude_of
 from layered_swim.control.stroke import available_strokes, stroke_path
 from layered_swim.control.targets import MovableTarget, TrajectoryTarget, load_trajectory
 from layered_swim.episode import Episode
+from layered_swim.fluid.flow_field import load_water
 from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S, water
 from layered_swim.render.scene import Scene
 from layered_swim.sim.simulation import PHYSICS_HZ, SimulationDiverged
@@ -75,7 +76,8 @@ class ActiveTarget:
 class SwimSession:
     def __init__(self, stroke: str = "breaststroke", layers: Layers = Layers(), current_m_s=(0.0, 0.0, 0.0),
                  density_kg_m3: float | None = None, trajectory: str | None = None, physics_hz: int = PHYSICS_HZ,
-                 backend: str = "plate", fluid_settings=None, policy=None):
+                 backend: str = "plate", fluid_settings=None, policy=None, water: str | None = None):
+        """``water``: a water file (name or path) whose flow field is added to the current."""
         self.strokes = available_strokes() + [AUTO]
         if stroke != AUTO:
             stroke_path(stroke)                      # unknown stroke: one-line error before anything opens
@@ -87,6 +89,7 @@ class SwimSession:
             policy.check_stroke(stroke)
             self.strokes = [stroke]
         self.currents, self.current_index = _presets(CURRENT_PRESETS_M_S, tuple(current_m_s), "custom current")
+        self.flow = load_water(water) if water else None
         density = DENSITY_PRESETS_KG_M3[0][1] if density_kg_m3 is None else float(density_kg_m3)
         self.densities, self.density_index = _presets(DENSITY_PRESETS_KG_M3, density, f"{density:g} kg/m3")
         trajectory_target = load_trajectory(trajectory) if trajectory else None
@@ -107,7 +110,7 @@ class SwimSession:
     # --- building ----------------------------------------------------------------------
     def _medium(self):
         return water(density_kg_m3=self.densities[self.density_index].value,
-                     current_m_s=self.currents[self.current_index].value)
+                     current_m_s=self.currents[self.current_index].value, flow=self.flow)
 
     def _build(self, stroke: str, position_xy_m, heading_rad: float, use_start_speed: bool) -> None:
         old = getattr(self, "episode", None)
@@ -304,7 +307,10 @@ class SwimSession:
         return Scene(body.segment_names, body.half_extents_m, state.pos_m, state.quat_xyzw, self.target_m,
                      self.trajectory_path_m if self.target.scripted else None, np.array(self.trail),
                      self.sim.fluid_force_n, self.current_m_s, *(water or (None, None)),
-                     flow_m_s=self.sim.fluid_now.flow_m_s)
+                     flow_m_s=self.sim.fluid_now.flow_m_s, water_at=self._water_at if self.flow else None)
+
+    def _water_at(self, points_m: np.ndarray) -> np.ndarray:
+        return self.sim.fluid.medium.current_at(points_m, self.sim.time_s)
 
     def close(self) -> None:
         self.episode.close()

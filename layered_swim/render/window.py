@@ -85,7 +85,7 @@ class SwimWindow(pyglet.window.Window):
         self.push_handlers(self.keys)
         self.show_help = False
         self.show_forces = False
-        self.show_flow = False
+        self.show_flow = session.flow is not None     # a water file: its flow is what the swim is about
         self._screenshot_pending = False
         self.recorder: FrameWriter | None = None
         self._last_video_frame_s = -math.inf

@@ -39,7 +39,7 @@ class FollowTarget(Task):
         self._every = episode.sim.config.physics_hz // TRACK_HZ
         self._stroke = episode.stroke.name
         self._samples: dict[str, list] = {"track_time_s": [], "swimmer_m": [], "target_m": [],
-                                          "pelvis_m": [], "heading_error_rad": [], "roll_rad": []}
+                                          "pelvis_m": [], "heading_error_rad": [], "roll_rad": [], "stroke": []}
         return moved_start(episode.stroke.start_state(), self.start_xy_m, self.start_speed_m_s, self.start_heading_rad)
 
     def observe(self, sim) -> None:
@@ -56,11 +56,12 @@ class FollowTarget(Task):
         rows["pelvis_m"].append(state.pos("pelvis"))
         rows["heading_error_rad"].append(bearing_error(com, goal, att.heading_rad))
         rows["roll_rad"].append(att.roll_rad)
+        rows["stroke"].append(sim.controller.stroke.name)
 
     def track(self) -> dict[str, np.ndarray]:
         """Per sample: ``track_time_s``, ``swimmer_m`` (centre of mass), ``target_m`` and ``pelvis_m``
         (n, 3), ``heading_error_rad`` (the target's bearing off the heading), ``roll_rad`` (shoulder
-        roll)."""
+        roll), ``stroke`` (the stroke swimming: ``auto`` switches)."""
         return {name: np.array(rows) for name, rows in self._samples.items()}
 
     def metrics(self) -> dict:
@@ -70,6 +71,7 @@ class FollowTarget(Task):
                   "final_distance_m": float(distance[-1]),
                   "mean_heading_error_deg": float(np.degrees(np.abs(a["heading_error_rad"])).mean())}
         result.update(hold_depth(a["track_time_s"], a["pelvis_m"], a["target_m"]))
+        result["strokes_swum"] = stroke_spells(a["track_time_s"], a["stroke"])
         if getattr(self.target, "kind", None) == "stations":
             result.update(station_metrics(a["track_time_s"], distance, [t for t, _ in self.target.stations]))
         if getattr(self.target, "kind", None) == "line":
@@ -81,6 +83,15 @@ class FollowTarget(Task):
                 a["track_time_s"], a["swimmer_m"], np.degrees(a["roll_rad"]), start, direction, speed,
                 bench.ROLL_TOLERANCE_DEG.get(self._stroke, 45.0))
         return result
+
+
+def stroke_spells(time_s: np.ndarray, strokes: np.ndarray) -> list[dict]:
+    """Which stroke swam when: one ``{stroke, from_s, to_s}`` per unbroken spell of one stroke."""
+    if not len(time_s):
+        return []
+    changes = [0] + [i for i in range(1, len(strokes)) if strokes[i] != strokes[i - 1]] + [len(strokes)]
+    return [{"stroke": str(strokes[a]), "from_s": float(time_s[a]), "to_s": float(time_s[min(b, len(time_s) - 1)])}
+            for a, b in zip(changes, changes[1:])]
 
 
 def hold_depth(time_s: np.ndarray, pelvis_m: np.ndarray, target_m: np.ndarray) -> dict:

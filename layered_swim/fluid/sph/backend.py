@@ -60,6 +60,9 @@ class SphBackend(FluidBackend):
         self.peak_window_force_n = 0.0
 
     def _check_medium(self, medium: Medium) -> None:
+        if medium.flow is not None:
+            raise ConfigError("a water file's flow field (--water) runs on the plate backend only: an SPH pool "
+                              "takes a uniform --current")
         if medium.current_m_s[2]:
             raise ConfigError("an SPH pool's current must be horizontal (its z part 0): it flows in through "
                               "one end of the pool and out through the other")
