@@ -52,7 +52,7 @@ def test_experiment_list():
     assert result.returncode == 0, result.stderr
     names = {line.split()[0] for line in result.stdout.splitlines()[1:]}
     assert names == {"hand-force", "turn", "palm-rule", "layers-in-current", "density-sweep", "current-sweep",
-                     "perturbation", "swim-table", "swim-generalisation"}
+                     "perturbation", "swim-table", "swim-generalisation", "robustness"}
 
 
 @pytest.mark.parametrize("args, words", [

@@ -45,6 +45,23 @@ def test_two_workers_give_the_same_results(tmp_path):
     assert sweep.run_sweep(square, configs, None, workers=2) == sweep.run_sweep(square, configs, None, workers=1)
 
 
+def test_ray_tasks_give_the_same_results_and_fill_the_same_cache(tmp_path):
+    """``ray_address="local"``: a Ray runtime started here runs the jobs; the results, their order
+    and the cache are the local processes'."""
+    import ray
+
+    def power(config: dict) -> dict:      # nested: Ray ships it by value (its workers cannot import tests/)
+        return {"power": config["x"] ** 4}
+
+    configs = [{"x": x} for x in range(4)]
+    try:
+        on_ray = sweep.run_sweep(power, configs, tmp_path, workers=2, ray_address="local")
+    finally:
+        ray.shutdown()
+    assert on_ray == sweep.run_sweep(power, configs, None, workers=1) == [{"power": x ** 4} for x in range(4)]
+    assert len(list(tmp_path.glob("*.json"))) == 4
+
+
 def test_a_run_does_not_depend_on_the_hash_seed(tmp_path):
     """Sweeps run in fresh processes, each with its own hash seed: nothing may iterate a set
     where the order reaches the numbers (it did, in the per-cycle weight blending)."""

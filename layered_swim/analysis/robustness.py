@@ -43,7 +43,7 @@ def spread(values: list) -> dict | None:
 
 
 def follow_seeds(spec: SwimSpec, seeds: int = 10, out_dir: OutputFolder | str | Path | None = None,
-                 workers: int = 2, progress: bool = False) -> dict:
+                 workers: int = 2, progress: bool = False, ray_address: str | None = None) -> dict:
     """``spec`` (a follow task) from seeds 1..``seeds``, each start moved within ``WIDE_JITTER``;
     with ``spec.policy``, a trained residual drives its own reference controller."""
     if not 1 <= seeds <= MAX_SEEDS:
@@ -59,7 +59,7 @@ def follow_seeds(spec: SwimSpec, seeds: int = 10, out_dir: OutputFolder | str | 
     if out_dir is not None:       # the first start checked here (files, stroke, path), then the folder claimed
         follow_run(spec.with_(seconds=MIN_SECONDS), steering=steering)
         out = claim(out_dir)
-    runs = run_sweep(follow_one, configs, None, workers, progress, desc="starts")
+    runs = run_sweep(follow_one, configs, None, workers, progress, desc="starts", ray_address=ray_address)
     summary = {**common, "seeds": seeds, "start_jitter": asdict(WIDE_JITTER),
                "median": {k: s for k in HEADLINES if (s := spread([r.get(k) for r in runs])) is not None},
                "runs": runs}

@@ -75,9 +75,15 @@ def _store(path: Path, config: dict, result) -> None:
     write_text(path, json.dumps({"config": config, "result": result}, allow_nan=False))   # whole or not at all
 
 
+RAY_INSTALL = "pip install -e '.[ray]'"
+
+
 def run_sweep(task: Callable[[dict], object], configs: list[dict], cache_dir: str | Path | None = None,
-              workers: int = DEFAULT_WORKERS, progress: bool = False, desc: str = "runs") -> list:
-    """``task(config)`` for every configuration, in order; cached ones are read, not run."""
+              workers: int = DEFAULT_WORKERS, progress: bool = False, desc: str = "runs",
+              ray_address: str | None = None) -> list:
+    """``task(config)`` for every configuration, in order; cached ones are read, not run. With
+    ``ray_address`` (a Ray cluster's address, or ``local`` for one started here with ``workers``
+    CPUs) the jobs run as Ray tasks instead of local processes."""
     paths = [Path(cache_dir) / f"{cache_key(task, c)}.json" if cache_dir is not None else None for c in configs]
     results = [_load(p) if p is not None else None for p in paths]
     todo = [i for i, r in enumerate(results) if r is None]
@@ -93,7 +99,9 @@ def run_sweep(task: Callable[[dict], object], configs: list[dict], cache_dir: st
             bar.update(1)
 
         workers = max(1, min(workers, len(todo)))
-        if workers == 1:
+        if ray_address:
+            _run_on_ray(task, configs, todo, done, ray_address, workers)
+        elif workers == 1:
             for i in todo:
                 done(i, task(configs[i]))
         else:
@@ -103,3 +111,18 @@ def run_sweep(task: Callable[[dict], object], configs: list[dict], cache_dir: st
                 for future in as_completed(futures):
                     done(futures[future], future.result())
     return results
+
+
+def _run_on_ray(task, configs: list[dict], todo: list[int], done, address: str, workers: int) -> None:
+    try:
+        import ray
+    except ImportError:
+        raise ConfigError(f"--ray needs the [ray] extra: {RAY_INSTALL}") from None
+    if not ray.is_initialized():
+        ray.init(address=None if address == "local" else address, num_cpus=workers if address == "local" else None,
+                 include_dashboard=False, log_to_driver=False)
+    remote = ray.remote(num_cpus=1)(task)
+    pending = {remote.remote(configs[i]): i for i in todo}
+    while pending:
+        ready, _ = ray.wait(list(pending), num_returns=1)
+        done(pending.pop(ready[0]), ray.get(ready[0]))

@@ -11,6 +11,7 @@ from layered_swim.commands.options import (
     overwrite_option,
     parallel_options,
     progress,
+    ray_option,
 )
 from layered_swim.commands.tables import table
 
@@ -23,6 +24,7 @@ def add_parser(subparsers) -> None:
     overwrite_option(experiment)
     experiment.add_argument("--quick", action="store_true", help="fewer and shorter runs, for a first look")
     parallel_options(experiment)
+    ray_option(experiment)
     experiment.add_argument("--seed", type=int, default=0, help="seed of the random pushes (perturbation)")
     experiment.add_argument("--json", action="store_true", help="print the experiment's summary as one JSON object")
     backend_option(experiment, pool="large")     # only hand-force runs in SPH water (`experiment list`)
@@ -47,7 +49,7 @@ def run(args) -> None:
 
         make_fluid(args.backend, load_body(), Medium(), GRAVITY_M_S2, settings)
     summary = run_experiment(module, out, quick=args.quick, workers=args.workers, progress=progress(args),
-                             seed=args.seed, backend=args.backend, fluid_settings=settings)
+                             seed=args.seed, backend=args.backend, fluid_settings=settings, ray_address=args.ray)
     if args.json:
         print(json.dumps({**summary, "out_dir": str(out.path)}, allow_nan=False))
         return

@@ -13,6 +13,7 @@ from layered_swim.commands.options import (
     overwrite_option,
     parallel_options,
     progress,
+    ray_option,
     steering_options,
     swim_spec,
 )
@@ -36,6 +37,7 @@ def add_parser(subparsers) -> None:
                         help="swim N times from starts moved by up to 10 deg and 0.3 m, and report each headline "
                              "number's median (and range) over them (with --policy too)")
     parallel_options(follow)
+    ray_option(follow)
     backend_option(follow, pool="large")       # a trajectory's target starts 2 m ahead
 
 
@@ -48,6 +50,10 @@ def run(args) -> None:
     if args.seeds is not None:
         _follow_seeds(args, spec)
         return
+    if args.ray:
+        from layered_swim.config import ConfigError
+
+        raise ConfigError("--ray spreads the starts of --seeds N: one swim runs here")
     out = out_dir(args, default_out_dir(f"follow-{Path(args.trajectory).stem}"))
     target = export_target(args)
     result = follow_run(spec, out, steering_for(spec))
@@ -73,7 +79,7 @@ def _follow_seeds(args, spec) -> None:
     if args.export:
         raise ConfigError("--export writes one swim: not with --seeds")
     out = out_dir(args, default_out_dir(f"follow-{Path(args.trajectory).stem}-seeds"))
-    summary = follow_seeds(spec, args.seeds, out, args.workers, progress(args))
+    summary = follow_seeds(spec, args.seeds, out, args.workers, progress(args), ray_address=args.ray)
     if args.json:
         print(json.dumps({**summary, "out_dir": str(out.path)}, allow_nan=False))
         return

@@ -193,6 +193,12 @@ def parallel_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
+def ray_option(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--ray", metavar="ADDRESS", help="run the sweep's simulations as Ray tasks on this cluster "
+                                                          "(`local`: one started here with --workers CPUs; the [ray] "
+                                                          "extra) instead of local processes")
+
+
 def vector(text: str, what: str) -> tuple[float, float, float]:
     """``X,Y,Z`` as three finite numbers, else a one-line ConfigError naming ``what``."""
     from layered_swim.config import ConfigError

@@ -8,6 +8,7 @@ from layered_swim.analysis.experiments import (
     layers_in_current,
     palm_rule,
     perturbation,
+    robustness,
     swim_generalisation,
     swim_table,
     turn,
@@ -15,7 +16,7 @@ from layered_swim.analysis.experiments import (
 from layered_swim.config import ConfigError
 
 EXPERIMENTS = {m.NAME: m for m in (hand_force, turn, palm_rule, layers_in_current, density_sweep, current_sweep,
-                                   perturbation, swim_table, swim_generalisation)}
+                                   perturbation, swim_table, swim_generalisation, robustness)}
 
 
 def experiment(name: str):

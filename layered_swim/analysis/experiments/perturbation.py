@@ -4,8 +4,8 @@ longer, so ours follows a target along a straight line for 30 s and is pushed on
 
 The swimmer is the breaststroke with all three layers, standing in for SWIM's freestyle. That is
 this experiment's choice, not a limit of the crawl: the front crawl follows moving targets for
-minutes too (mean distance, median over 10 starts: the figure-eight 0.54 m in 120 s, a line in a
-0.3 m/s cross current 0.79 m in 60 s; docs/results.md)."""
+minutes too (mean distance, median over 10 starts: the figure-eight 0.64 m in 120 s, a line in a
+0.3 m/s cross current 1.32 m in 60 s; docs/results.md)."""
 from __future__ import annotations
 
 from pathlib import Path

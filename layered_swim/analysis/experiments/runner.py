@@ -37,7 +37,8 @@ class Outcome:
 
 
 def run_experiment(module, out_dir: OutputFolder | str | Path, quick: bool = False, workers: int = 2,
-                   progress: bool = False, seed: int = 0, backend: str = "plate", fluid_settings=None) -> dict:
+                   progress: bool = False, seed: int = 0, backend: str = "plate", fluid_settings=None,
+                   ray_address: str | None = None) -> dict:
     if not isinstance(seed, int) or seed < 0:
         raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
     backends = getattr(module, "BACKENDS", ("plate",))
@@ -52,7 +53,8 @@ def run_experiment(module, out_dir: OutputFolder | str | Path, quick: bool = Fal
     # whose cache it reuses), not one it refuses as foreign.
     write_json(out / "config.json", {COMMAND_KEY: "experiment", "experiment": module.NAME, "quick": quick,
                                       "seed": seed, "runs": configs, "versions": versions()})
-    results = run_sweep(module.run, configs, out / "cache", workers, progress, desc=module.NAME)
+    results = run_sweep(module.run, configs, out / "cache", workers, progress, desc=module.NAME,
+                        ray_address=ray_address)
     numbers = module.measure(configs, results)
     write_csv(out / module.CSV, numbers["rows"])
     module.plot(numbers, out / module.FIGURE)
