@@ -101,7 +101,8 @@ def test_bad_fit_files_are_one_line(tmp_path, changes, words):
 
 
 def test_the_shipped_fit_files_load():
-    for name in ("front_crawl", "breaststroke", "butterfly", "backstroke", "front_crawl_turns", "breaststroke_turns"):
+    for name in ("front_crawl", "breaststroke", "butterfly", "backstroke", "front_crawl_turns", "breaststroke_turns",
+                 "backstroke_turns"):
         spec, stroke, source = load_fit(name)
         assert spec.stroke == name.removesuffix("_turns") and stroke["name"] == spec.stroke and source.is_file()
 
