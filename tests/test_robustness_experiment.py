@@ -57,6 +57,7 @@ def test_the_table_holds_a_cell_at_one_metre_and_takes_medians_over_starts():
     assert push["median_back_after_push_s"] == 3.0 and push["pushes_not_back"] == 1
     assert numbers["summary"]["held_share"] == {"s": 0.5}
     assert numbers["summary"]["median_back_after_push_s"] == {"s": 3.0}
+    assert numbers["summary"]["back_in_time"] == {"s": True}      # 3 s: within the 5 s asked
 
 
 def test_one_pushed_cell_swims_and_is_measured():
