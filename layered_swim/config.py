@@ -34,6 +34,12 @@ Degrees = between(-360.0, 360.0)
 Coordinate_m = between(-1e4, 1e4)        # anywhere in a 20 km square
 
 
+class Point2(Strict):
+    """A horizontal point in a file (a curve's centre, a vortex's), metres."""
+    x: Coordinate_m
+    y: Coordinate_m
+
+
 class Vec3(Strict):
     """A body-scale vector (axes, offsets, sizes in m)."""
 

@@ -113,7 +113,9 @@ def run_sweep(task: Callable[[dict], object], configs: list[dict], cache_dir: st
     return results
 
 
-def _run_on_ray(task, configs: list[dict], todo: list[int], done, address: str, workers: int) -> None:
+def ray_runtime(address: str, workers: int):
+    """The ``ray`` module, connected to the cluster at ``address`` (``local``: one started here
+    with ``workers`` CPUs) unless already; a one-line error without the [ray] extra."""
     try:
         import ray
     except ImportError:
@@ -121,6 +123,11 @@ def _run_on_ray(task, configs: list[dict], todo: list[int], done, address: str, 
     if not ray.is_initialized():
         ray.init(address=None if address == "local" else address, num_cpus=workers if address == "local" else None,
                  include_dashboard=False, log_to_driver=False)
+    return ray
+
+
+def _run_on_ray(task, configs: list[dict], todo: list[int], done, address: str, workers: int) -> None:
+    ray = ray_runtime(address, workers)
     remote = ray.remote(num_cpus=1)(task)
     pending = {remote.remote(configs[i]): i for i in todo}
     while pending:

@@ -26,6 +26,7 @@ from layered_swim.config import (
     SHIPPED_DIR,
     ConfigError,
     Coordinate_m,
+    Point2,
     Strict,
     available_files,
     between,
@@ -153,11 +154,6 @@ def target_speed_m_s(target: Target, time_s: float, over_s: float = 1.0) -> floa
 Length_m = between(0.0, 1e4, above=True)
 Time_s = between(0.0, 1e5)            # a day at most
 Heading_deg = between(-3600.0, 3600.0)
-
-
-class Point2(Strict):
-    x: Coordinate_m
-    y: Coordinate_m
 
 
 class Size2(Strict):

@@ -22,7 +22,7 @@ from pydantic import Field
 from layered_swim.config import (
     SHIPPED_DIR,
     ConfigError,
-    Coordinate_m,
+    Point2,
     Strict,
     available_files,
     between,
@@ -35,11 +35,6 @@ from layered_swim.config import (
 WATER_DIR = SHIPPED_DIR / "water"      # the top-level water/ in a checkout
 GRAVITY_M_S2 = 9.81
 MAX_STEEPNESS = 0.3      # wave amplitude x wavenumber: linear theory holds well below breaking (~0.44)
-
-
-class Point2(Strict):
-    x: Coordinate_m
-    y: Coordinate_m
 
 
 class Vector3(Strict):

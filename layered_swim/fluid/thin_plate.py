@@ -142,8 +142,8 @@ class PlateFluid(FluidBackend):
         # The kernel returns the four arrays in FluidWrenches' order; wrapping the tuple as it is
         # skips the named constructor's argument handling (this runs every physics step).
         if self.medium.flow is not None:      # the water moves differently at every segment, and in time
-            self._medium[0:3] = self.medium.current_at(state.com_m, state.time_s)[0]
-            self._segment_current = self.medium.current_at(state.pos_m, state.time_s)
+            water = self.medium.current_at(np.vstack([state.pos_m, state.com_m]), state.time_s)
+            self._segment_current, self._medium[0:3] = water[:-1], water[-1]
         out = _fluid_wrenches(state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s, self._segments,
                               self._medium, self._coefficients, self._segment_current)
         if self.added_mass is None:

@@ -11,11 +11,9 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import torch
 
-from layered_swim.config import ConfigError
+from layered_swim.analysis.sweep import ray_runtime
 from layered_swim.rl.buffer import EpisodeData
 from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, ModelArgs, Normaliser
-
-RAY_INSTALL = "pip install -e '.[ray]'"
 
 
 def make_env(env_kwargs: dict):
@@ -90,13 +88,7 @@ class Rollouts:
     def __init__(self, env_kwargs: dict, workers: int, ray_address: str | None = None):
         self.workers, self._pool, self._ray = workers, None, None
         if ray_address:
-            try:
-                import ray
-            except ImportError:
-                raise ConfigError(f"--ray needs the [ray] extra: {RAY_INSTALL}") from None
-            if not ray.is_initialized():
-                ray.init(address=None if ray_address == "local" else ray_address, num_cpus=workers
-                         if ray_address == "local" else None, include_dashboard=False, log_to_driver=False)
+            ray = ray_runtime(ray_address, workers)
             actor = ray.remote(num_cpus=1)(_RayWorker)
             self._ray = [actor.remote(env_kwargs) for _ in range(workers)]
         elif workers > 1:
