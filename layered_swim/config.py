@@ -134,7 +134,7 @@ def load(model: type[Model], path: str | Path) -> Model:
     return parse(model, load_yaml(path), path)
 
 
-SHIPPED_DIR = Path(__file__).resolve().parent / "shipped"     # the package's strokes/, trajectories/, water/
+SHIPPED_DIR = Path(__file__).resolve().parent / "shipped"     # the package's strokes/, trajectories/, waters/
 
 
 def search_dirs(kind: str) -> tuple[Path, ...]:

@@ -145,7 +145,7 @@ def current_option(command: argparse.ArgumentParser) -> None:
 
 
 def water_option(command: argparse.ArgumentParser) -> None:
-    command.add_argument("--water", metavar="FILE", help="a flow field: a water file's name (see water/) or path "
+    command.add_argument("--water", metavar="FILE", help="a flow field: a water file's name (see waters/) or path "
                                                          "(sources, sinks, vortices, waves), added to --current")
 
 

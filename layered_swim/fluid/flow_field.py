@@ -1,5 +1,5 @@
 """Water that moves differently from place to place: a flow built from primitives (Yang et al. 2004,
-section 3.3), read from a ``water`` file (``water/`` in a checkout).
+section 3.3), read from a ``water`` file (``waters/`` in a checkout).
 
 The primitives are the plane potential flows (uniform, source, sink, vortex), the same at every
 depth, and a travelling surface wave (linear deep-water theory) whose orbital velocity decays with
@@ -32,7 +32,7 @@ from layered_swim.config import (
     search_dirs,
 )
 
-WATER_DIR = SHIPPED_DIR / "water"      # the top-level water/ in a checkout
+WATER_DIR = SHIPPED_DIR / "waters"      # the top-level waters/ in a checkout
 GRAVITY_M_S2 = 9.81
 MAX_STEEPNESS = 0.3      # wave amplitude x wavenumber: linear theory holds well below breaking (~0.44)
 
@@ -141,7 +141,7 @@ def _wave(flow: WaveSpec, points: np.ndarray, time_s: float) -> np.ndarray:
 
 
 def available_waters(directory: Path | None = None) -> list[str]:
-    return available_files(directory or search_dirs("water"))
+    return available_files(directory or search_dirs("waters"))
 
 
 def parse_water(data: Any, source: str | Path) -> WaterSpec:
@@ -150,5 +150,5 @@ def parse_water(data: Any, source: str | Path) -> WaterSpec:
 
 def load_water(name_or_path: str | Path, directory: Path | None = None) -> FlowField:
     """A water file by bare name (``river_bend``) or by path to a YAML file."""
-    path = file_path(name_or_path, directory or search_dirs("water"), "water")
+    path = file_path(name_or_path, directory or search_dirs("waters"), "water")
     return FlowField(parse_water(load_yaml(path), path), str(path))
