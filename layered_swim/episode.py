@@ -139,7 +139,8 @@ class Episode:
     def run(self, seconds: float | None = None, *, steps: int | None = None, observers: Iterable[Observer] = (),
             progress: bool = False) -> None:
         """Run ``seconds`` of simulated time (or exactly ``steps`` physics steps), calling every
-        observer after every step; ``progress`` shows a bar of simulated seconds."""
+        observer after every step, unless the task ends the episode first (``task.ended``);
+        ``progress`` shows a bar of simulated seconds."""
         hz = self.sim.config.physics_hz
         n = int(round(seconds * hz)) if steps is None else steps
         observers = list(observers)
@@ -158,6 +159,8 @@ class Episode:
                         every_step(sim)
                     if stop:
                         raise KeyboardInterrupt
+                    if task.ended is not None:
+                        break
         finally:
             if progress:
                 bar.close()

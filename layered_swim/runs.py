@@ -305,7 +305,8 @@ def goal_episode(spec: SwimSpec, wrap=None) -> Episode:
 
 
 def reach_goal(episode: Episode, goal: int, observers=()) -> dict:
-    """Swim to goal ``goal`` for the pool's horizon: Pos, Prog, Dev and Roll."""
+    """Swim to goal ``goal`` for the pool's horizon, or until the pool's walls or floor end the
+    swim: Pos, Prog, Dev and Roll over the whole horizon, and whether it swam to the end."""
     episode.reset(goal=goal)
     episode.run(episode.task.duration_s, observers=observers)
     return episode.metrics()
@@ -336,6 +337,7 @@ def goal_run(spec: SwimSpec, out_dir: OutputFolder | str | Path | None = None) -
     finally:
         episode.close()
     mean = {k: float(np.mean([g[k] for g in per_goal])) for k in GOAL_METRICS}
+    mean["success_rate"] = float(np.mean([g["success"] for g in per_goal]))
     pool = spec.task.pool
     result = {"pool": pool, "stroke": spec.stroke, "layers": spec.layer_set.describe(),
               "current_m_s": list(spec.medium.current_m_s), "fluid_backend": spec.backend, **mean, "goals": per_goal,

@@ -26,9 +26,12 @@ from layered_swim.sim.simulation import PHYSICS_HZ
 MAX_SECONDS = 24 * 3600.0     # a day: soak's longest; the log streams to disk, memory stays flat
 MIN_SECONDS = 0.1             # a few log samples, so the metrics have a time span
 JITTERS = {"start": START_JITTER, "wide": WIDE_JITTER}
-# Slow strokes: the goal line is slow. Its schedule is not a pace to keep: keeping the calibrated
+# The goal line is slow (0.375 m/s), but its schedule is not a pace to keep: keeping the calibrated
 # pace of the goal's speed (steady, straight) brought the crawl there far too early (Prog 1.16).
-GOAL_TEMPO = TempoControl(min_tempo=0.25, near_m=0.3, far_m=1.0, keep_pace=False)
+# Below 0.6 of its tempo the crawl stalls and sinks: at 0.25 it fell behind in the large pool's
+# 8 s (Prog 0.51, half its swims on the 0.7 m floor); at 0.6 it keeps the schedule there (1.01)
+# and in the small pool (Prog 0.72 -> 0.90; 3 goals x 2 starts each).
+GOAL_TEMPO = TempoControl(min_tempo=0.6, near_m=0.3, far_m=1.0, keep_pace=False)
 
 Speed_m_s = between(-5.0, 5.0)
 

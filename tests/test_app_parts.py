@@ -242,18 +242,22 @@ def test_frame_writer_png_fallback(tmp_path):
     assert [np.asarray(Image.open(f)).mean() for f in frames] == [0, 128]
 
 
-def test_a_shipped_policy_drives_the_session_and_the_hud_says_so():
+SHIPPED_POLICIES = Path(__file__).resolve().parents[1] / "layered_swim/rl/policies"
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in SHIPPED_POLICIES.glob("*.pt")))
+def test_every_shipped_policy_drives_the_session_and_the_hud_says_so(name):
     from layered_swim.render.hud import hud_lines
     from layered_swim.rl.policy import ResidualPolicy
 
-    shipped = Path(__file__).resolve().parents[1] / "layered_swim/rl/policies/front_crawl_layered.pt"
-    policy = ResidualPolicy.load(shipped)
-    s = SwimSession("front_crawl", policy=policy)
+    policy = ResidualPolicy.load(SHIPPED_POLICIES / name)
+    stroke = policy.env.stroke
+    s = SwimSession(stroke, policy=policy)
     s.step(64)
     assert np.isfinite(s.com_m).all() and np.any(s.sim.controller.residual_rad != 0.0)
-    assert any("learned residual" in line for line in hud_lines(s, 60.0))
+    assert any(f"learned residual on the {policy.env.reference} controller" in line for line in hud_lines(s, 60.0))
     s.toggle_layer("palm")
     assert "keeps the layers" in s.message
     s.close()
-    with pytest.raises(ConfigError, match="trained for front_crawl"):
+    with pytest.raises(ConfigError, match=f"trained for {stroke}"):
         SwimSession("breaststroke", policy=policy)

@@ -285,12 +285,19 @@ def test_yaml_example_loads(where, data):
                 load_fit(Path(tmp) / "fit.yaml")
         elif isinstance(data, dict) and "period_s" in data:
             build_stroke(parse_model(StrokeSpec, data, where), joint_layout(load_body()), where)
+        elif isinstance(data, dict) and "env" in data:
+            from layered_swim.rl.config import load_train_spec
+
+            with tempfile.TemporaryDirectory() as tmp:
+                (Path(tmp) / "train.yaml").write_text(yaml.safe_dump(data))
+                load_train_spec(Path(tmp) / "train.yaml")
         elif isinstance(data, dict) and "flows" in data:
             from layered_swim.fluid.flow_field import FlowField, parse_water
 
             FlowField(parse_water(data, where), where)
         else:
-            raise AssertionError(f"{where}: a YAML example of no known kind (trajectory, stroke, fit or water)")
+            raise AssertionError(f"{where}: a YAML example of no known kind (trajectory, stroke, fit, water "
+                                 "or training)")
     except ConfigError as err:
         raise AssertionError(f"{where}: {err}") from None
 

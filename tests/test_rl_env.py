@@ -13,6 +13,7 @@ from layered_swim.rl import observation as obs
 from layered_swim.rl.config import RewardSpec
 from layered_swim.rl.env import SwimGoalEnv
 from layered_swim.rl.reward import deviation_m, forward_distance_m, reward_parts, yaw_error_rad
+from layered_swim.tasks import swim_benchmark as bench
 
 
 @pytest.fixture(scope="module")
@@ -174,3 +175,70 @@ def test_same_seed_same_episode():
         return o, r
     (a, ra), (b, rb) = rollout(3), rollout(3)
     assert np.array_equal(a, b) and ra == rb
+
+
+def test_the_heuristic_ends_at_the_same_walls_and_is_scored_to_the_horizon():
+    from layered_swim.runs import goal_episode, reach_goal
+    from layered_swim.spec import SwimSpec
+
+    spec = SwimSpec.of("test", stroke="front_crawl", task={"kind": "goal", "pool": "small"},
+                       medium={"current_m_s": (2.0, 0.0, 0.0)}, layers="basic,cycle,rules")
+    episode = goal_episode(spec)
+    try:
+        got = reach_goal(episode, 0)
+        assert not got["success"] and "left the small pool" in got["ended"]
+        assert got["ended_s"] < 4.0 and episode.time_s == pytest.approx(got["ended_s"], abs=0.06)   # it stopped there
+        assert got["prog"] > 1.0          # carried past the goal, and held there to the horizon
+        episode.task.ends_at_walls = False                  # boundless water: the whole horizon is swum
+        assert reach_goal(episode, 0)["success"] and episode.time_s == pytest.approx(4.0)
+    finally:
+        episode.close()
+
+
+def test_draws_pick_the_pool_goal_water_and_push_and_a_named_goal_draws_nothing():
+    from layered_swim.rl.env import TRAINING_SEEDS
+
+    draws = {"pools": ["large"], "goal_bearing_deg": 30.0, "current_m_s": {"min": 0.5, "max": 0.5},
+             "density_kg_m3": {"min": 1200.0, "max": 1200.0}, "push_chance": 1.0,
+             "push_body_weights": {"min": 1.0, "max": 1.0}, "push_s": {"min": 0.1, "max": 0.1}}
+    e = SwimGoalEnv(reference="basic", env_state="NoEnv", start_jitter=True, draws=draws)
+    try:
+        fresh = e.episode.sim.fluid.medium.rho_kg_m3
+        laterals = set()
+        for seed in range(4):
+            e.reset(seed=seed)
+            task, medium = e.episode.task, e.episode.sim.fluid.medium
+            assert task.duration_s == 8.0 and task.goal.goal_m[0] == 3.0          # the large pool's goal line
+            lateral = task.goal.goal_m[1]
+            laterals.add(round(lateral, 6))
+            assert abs(lateral) <= 3.0 * math.tan(math.radians(30.0)) + 1e-9
+            assert task.goal.pool.width_m >= 2 * (abs(lateral) + 0.5) - 1e-9
+            assert medium.rho_kg_m3 == 1200.0 and np.linalg.norm(medium.current_m_s) == pytest.approx(0.5)
+            assert e.push is not None and e.push.to_s - e.push.from_s == pytest.approx(0.1)
+            assert np.linalg.norm(e.push.force_n) == pytest.approx(e.weight_n)
+            assert e.episode.seed >= TRAINING_SEEDS                # evaluation's seeds are never drawn
+        assert len(laterals) == 4
+        # The push acts while its window is open.
+        e.reset(seed=0)
+        push, sim = e.push, e.episode.sim
+        while sim.time_s < push.from_s + 0.05:
+            e.step(np.zeros(e.action_space.shape, np.float32))
+        assert np.array_equal(sim.external_force_n[e.episode.body.index("pelvis")], push.force_n)
+        # A reset that names its goal is SWIM's: its pool, the environment's own water, no push.
+        e.reset(seed=0, options={"goal": 0, "start_seed": 0})
+        assert e.episode.task.duration_s == 4.0 and e.episode.task.goal == bench.goal_tasks(bench.pool("small"))[0]
+        assert e.episode.sim.fluid.medium.rho_kg_m3 == fresh and not any(e.episode.sim.fluid.medium.current_m_s)
+        assert e.push is None
+    finally:
+        e.close()
+
+
+def test_bad_draws_are_one_line():
+    from layered_swim.rl.config import load_train_spec
+
+    with pytest.raises(ConfigError, match="current_m_s"):
+        load_train_spec(None, ["env.draws.current_m_s={min: 0.5, max: 0.1}"])
+    with pytest.raises(ConfigError, match="density_kg_m3"):
+        load_train_spec(None, ["env.draws.density_kg_m3={min: 10, max: 100}"])
+    with pytest.raises(ConfigError, match="pools"):
+        load_train_spec(None, ["env.draws.pools=[ocean]"])

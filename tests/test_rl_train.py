@@ -150,7 +150,8 @@ def test_cli_train_then_goal_with_the_policy(tmp_path):
     goal = _cli("goal", "--policy", str(out / "policy.pt"), "--seeds", "1", "--json")
     assert goal.returncode == 0, goal.stderr
     result = json.loads(goal.stdout)
-    assert len(result["runs"]) == 3 and set(result["heuristic"]) == {"pos_m", "prog", "dev_m", "roll_deg"}
+    assert len(result["runs"]) == 3
+    assert set(result["heuristic"]) == {"pos_m", "prog", "dev_m", "roll_deg", "success_rate"}
     follow = _cli("follow", "straight_line", "--stroke", "front_crawl", "--seconds", "2", "--policy",
                   str(out / "policy.pt"), "--out", str(tmp_path / "f"), "--json")
     assert follow.returncode == 0, follow.stderr
@@ -183,11 +184,42 @@ def test_ray_workers_give_the_local_result(tmp_path):
 def test_swim_table_quick_has_every_controller_and_swims_the_shipped_policy(tmp_path):
     done = _cli("experiment", "swim-table", "--quick", "--out", str(tmp_path), "--no-progress", "--json")
     assert done.returncode == 0, done.stderr
-    rows = {r["controller"]: r for r in json.loads(done.stdout)["rows"]}
-    assert set(rows) == {"basic stroke", "layered", "basic + residual", "layered + residual"}
-    assert rows["layered + residual"]["missing"] is None and 0 < rows["layered + residual"]["pos_m"] < 1.0
-    assert "no trained basic-reference policy" in rows["basic + residual"]["missing"]
+    summary = json.loads(done.stdout)
+    rows = {(r["controller"], r["column"]): r for r in summary["rows"]}
+    names = ("basic stroke", "layered", "basic + residual", "layered + residual")
+    assert set(rows) == {(n, c) for n in names for c in ("3 m static", "3 m dynamic")}
+    for column in ("3 m static", "3 m dynamic"):
+        for name in ("layered + residual", "basic + residual"):      # both shipped policies swim
+            mine = rows[(name, column)]
+            assert mine["missing"] is None and 0 < mine["pos_m"] < 1.0 and mine["episodes"] == 1
+            assert mine["prog_error"] == pytest.approx(abs(1.0 - mine["prog"]))      # one episode
+            assert set(mine["beats_swim"]) == {"pos", "prog", "dev", "all"}
+        assert rows[("layered + residual", column)]["success_rate"] == 1.0
+    assert set(summary["residual_vs_swim"]["columns"]) == {"3 m static", "3 m dynamic"}
+    assert not summary["residual_vs_swim"]["all"]         # two columns of four are no verdict
     assert (tmp_path / "swim_table.png").is_file() and "SWIM" in (tmp_path / "swim_table.csv").read_text()
+
+
+def test_swim_table_scores_against_swim_by_hand():
+    from layered_swim.analysis.experiments import swim_table as st
+
+    runs = [{"pos_m": 0.1, "prog": 0.9, "dev_m": 0.03, "roll_deg": 0.0, "success": True},
+            {"pos_m": 0.2, "prog": 1.2, "dev_m": 0.05, "roll_deg": 1.0, "success": False}]
+    row = st.column_scores(runs)
+    assert row == pytest.approx({"episodes": 2, "pos_m": 0.15, "prog": 1.05, "prog_error": 0.15, "dev_m": 0.04,
+                                 "roll_deg": 0.5, "success_rate": 0.5})
+    swim = {"pos_m": 0.126, "prog": 0.712, "dev_m": 0.037}
+    assert st.against_swim(row, swim) == {"pos": False, "prog": True, "dev": False, "all": False}
+    good = {**row, "pos_m": 0.1, "dev_m": 0.03}
+    assert st.against_swim(good, swim)["all"]
+    rows = [{"controller": "layered + residual", "fluid": "plate", "column": c, "missing": None,
+             "beats_swim": {"all": True}, "success_rate": 1.0 if c != "5 m static" else 0.9} for c in st.COLUMNS]
+    verdict = st.verdict(rows)
+    assert verdict["columns"]["5 m static"] is False and not verdict["all"]      # an early end in quiet water
+    rows[2]["success_rate"] = 1.0
+    assert st.verdict(rows)["all"]
+    missing = st.run({"residual": "layered", "policy_sha256": None})       # no policy file: a row that says so
+    assert "no trained layered-reference policy" in missing["missing"]
 
 
 def test_pool_workers_end_with_a_killed_trainer():
@@ -208,3 +240,28 @@ def test_pool_workers_end_with_a_killed_trainer():
         time.sleep(0.2)
     assert len(workers) == 2
     assert not [p for p in workers if os.path.exists(f"/proc/{p}") and open(f"/proc/{p}/stat").read().split()[2] != "Z"]
+
+
+def test_a_training_starts_from_a_policy_of_the_same_shape(tmp_path):
+    first = train(load_train_spec(None, TINY), tmp_path / "a", say=None)
+    config = tmp_path / "stage2.yaml"
+    config.write_text("run:\n  start_from: a/policy.pt\n")          # relative to the configuration file
+    spec = load_train_spec(config, TINY)
+    assert spec.run.start_from == str((tmp_path / "a" / "policy.pt").resolve())
+    trainer, policy = Trainer(spec, tmp_path / "b"), ResidualPolicy.load(first["policy"])
+    for name, value in policy.model.state_dict().items():
+        assert torch.equal(trainer.model.state_dict()[name], value)
+    assert trainer.normaliser.mean == pytest.approx(policy.normaliser.mean)
+    with pytest.raises(ConfigError, match="another network"):
+        Trainer(load_train_spec(config, TINY + ["ppo.hidden=[8]"]), tmp_path / "c")
+    with pytest.raises(ConfigError, match="run.start_from: no policy file"):
+        load_train_spec(None, ["run.start_from=nowhere.pt"])
+
+
+def test_a_policy_file_from_before_draws_loads_as_trained_without_them():
+    from layered_swim.analysis.experiments.swim_table import POLICIES
+
+    quiet = ResidualPolicy.load(POLICIES / "front_crawl_layered_quiet.pt")
+    assert quiet.env.draws is None and quiet.env.pool == "small"
+    shipped = ResidualPolicy.load(POLICIES / "front_crawl_layered.pt")
+    assert shipped.env.reference == "layered" and shipped.env.draws.pools == ("small", "large")

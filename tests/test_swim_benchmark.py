@@ -148,3 +148,43 @@ def test_published_numbers():
     assert SWIM_PUBLISHED["small"]["M-PPO-3"]["pos_m"][0] == 0.177
     large = SWIM_PUBLISHED["large"]["SWIM"]
     assert [large[k][0] for k in ("pos_m", "prog", "dev_m")] == [0.217, 0.880, 0.144]
+
+
+def test_the_pool_ends_a_swim_past_its_walls_or_on_its_floor():
+    x0, x1 = SMALL.x_range_m                                  # -0.75 .. 2.25 m
+    assert SMALL.ending([0.0, 0.0, -0.2]) is None
+    assert "left the small pool" in SMALL.ending([x1 + 0.01, 0.0, -0.2])
+    assert "left the small pool" in SMALL.ending([0.5, -0.76, -0.2])     # 1.5 m wide
+    assert "sank to the floor of the 0.5 m" in SMALL.ending([0.5, 0.0, -0.51])
+
+
+def test_a_pool_holding_a_goal_off_its_three_is_widened_to_keep_it_inside():
+    wide = pool("large").holding(-1.25)
+    assert wide.goal_offsets_m == (-1.25,) and wide.width_m == pytest.approx(2 * (1.25 + 0.5))
+    assert pool("large").holding(0.3).width_m == pool("large").width_m       # already fits
+    assert goal_tasks(wide)[0].goal_m[1] == -1.25
+
+
+def test_an_episode_that_ended_early_is_held_where_it_stopped_to_the_horizon():
+    task = goal_tasks(SMALL)[0]                               # 1.5 m along +x in 4 s
+    t = timeline(1.0)
+    positions = goal_position(task, t) + [0.0, 0.2, 0.0]       # on schedule, 0.2 m to the left, for 1 s
+    got = metrics(task, positions, t=t, ended_s=1.0, step_s=0.05)
+    # Held at x = 0.375 m from t = 1 to 4 s: behind the schedule by 0.375 (t - 1) m.
+    held_t = np.arange(1.05, 4.0 + 1e-9, 0.05)
+    lag = 0.375 * (held_t - 1.0)
+    expected_pos = (np.sum(np.full(len(t), 0.2)) + np.sum(np.hypot(lag, 0.2))) / (len(t) + len(held_t))
+    assert got["pos_m"] == pytest.approx(expected_pos)
+    assert got["prog"] == pytest.approx(0.375 / 1.5)          # a quarter of the way when the horizon ends
+    assert got["dev_m"] == pytest.approx(0.2)
+    # Not ended: the same samples are scored over what was swum.
+    assert metrics(task, positions, t=t)["prog"] == pytest.approx(1.0)
+
+
+def test_table_3_has_all_four_columns():
+    from layered_swim.tasks.swim_benchmark import SWIM_PUBLISHED_TABLE3
+
+    assert list(SWIM_PUBLISHED_TABLE3) == ["3 m static", "3 m dynamic", "5 m static", "5 m dynamic"]
+    assert SWIM_PUBLISHED_TABLE3["3 m dynamic"]["SWIM"]["pos_m"] == (0.254, 0.104)
+    assert SWIM_PUBLISHED_TABLE3["5 m dynamic"]["SWIM"]["dev_m"][0] == 0.169
+    assert SWIM_PUBLISHED_TABLE3["5 m static"] == SWIM_PUBLISHED["large"]

@@ -59,6 +59,10 @@ def run(args) -> None:
     if "plate" in result:
         rows.append(["mean (plate)"] + [f"{result['plate'][k]:.3f}" for k in GOAL_METRICS])
     print(table(rows, ["", "Pos m", "Prog", "Dev m", "Roll deg"]))
+    for g in result["goals"]:
+        if not g["success"]:
+            print(f"goal y={g['goal_m'][1]:+.2f}: {g['ended']} after {g['ended_s']:.1f} s (scored to the horizon "
+                  "where it stopped)")
     if out is not None:
         print(f"\nwrote summary.json, config.json and goal-<k>/ (each a run folder) to {out.path}")
 
@@ -86,7 +90,8 @@ def _goal_policy(args) -> None:
     heuristic = goal_run(spec)
     result = {"policy": args.policy, "pool": args.pool, "stroke": stroke, "reference": policy.env.reference,
               "fluid_backend": args.backend, "current_m_s": list(current), "seeds": args.seeds, **result,
-              "heuristic": {k: heuristic[k] for k in GOAL_METRICS}, "swim_published": heuristic["swim_published"]}
+              "heuristic": {k: heuristic[k] for k in (*GOAL_METRICS, "success_rate")},
+              "swim_published": heuristic["swim_published"]}
     if args.json:
         print(json.dumps(result, allow_nan=False))
         return
@@ -98,4 +103,5 @@ def _goal_policy(args) -> None:
     rows.append(["heuristic (layered)"] + [fmt(result["heuristic"][k]) for k in GOAL_METRICS])
     print(table(rows, ["", "Pos m", "Prog", "Dev m", "Roll deg"]))
     if result["terminated"]:
-        print(f"{result['terminated']} of {len(result['runs'])} episodes ended early (left the pool or sank)")
+        print(f"{result['terminated']} of {len(result['runs'])} episodes ended early (left the pool or sank; "
+              "scored to the horizon where they stopped)")

@@ -30,6 +30,50 @@ def count(low: int, high: int):
 Hidden = Annotated[tuple[count(1, MAX_HIDDEN_WIDTH), ...], Field(min_length=1, max_length=MAX_HIDDEN_LAYERS)]
 
 
+class Range(Strict):
+    """A value drawn uniformly from ``min`` to ``max`` (equal: that value)."""
+
+    min: between(-1e6, 1e6)
+    max: between(-1e6, 1e6)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "Range":
+        if self.min > self.max:
+            raise ValueError(f"min {self.min:g} is above max {self.max:g}")
+        return self
+
+    def draw(self, rng) -> float:
+        return float(rng.uniform(self.min, self.max)) if self.max > self.min else float(self.min)
+
+
+class DrawsSpec(Strict):
+    """What every training episode draws (domain randomisation). A reset that names its goal
+    (evaluation on SWIM's fixed goals, ``evaluate_goals``) draws nothing."""
+
+    pools: tuple[Literal["small", "large"], ...] = Field(("small",), min_length=1)
+    # 0: one of the pool's three goals; above: a goal anywhere within this bearing either side of
+    # straight ahead (SWIM trains within 14 deg; its Fig. 4 tests out to 30), the pool widened to hold it.
+    goal_bearing_deg: between(0.0, 60.0) = 0.0
+    current_m_s: Range = Range(min=0.0, max=0.0)      # speed, from a direction drawn over the whole circle
+    density_kg_m3: Range | None = None                # None: the environment's own water
+    push_chance: between(0.0, 1.0) = 0.0              # the share of episodes pushed once, at a random moment
+    push_body_weights: Range = Range(min=1.0, max=3.0)
+    push_s: Range = Range(min=0.05, max=0.2)
+
+    @model_validator(mode="after")
+    def _physical(self) -> "DrawsSpec":
+        if self.current_m_s.min < 0 or self.current_m_s.max > 3.0:
+            raise ValueError("current_m_s must lie within 0-3 m/s (a speed; its direction is drawn)")
+        density = self.density_kg_m3
+        if density is not None and not (300.0 <= density.min and density.max <= 3000.0):
+            raise ValueError("density_kg_m3 must lie within 300-3000 kg/m^3")
+        if self.push_body_weights.min < 0 or self.push_body_weights.max > 10:
+            raise ValueError("push_body_weights must lie within 0-10")
+        if self.push_s.min <= 0 or self.push_s.max > 2.0:
+            raise ValueError("push_s must lie within 0-2 s and above 0")
+        return self
+
+
 class EnvSpec(Strict):
     """The environment a residual trains in (``SwimGoalEnv``'s arguments but the reward's weights
     and what a run changes: backend, current)."""
@@ -41,6 +85,7 @@ class EnvSpec(Strict):
     policy_hz: count(1, CONTROL_HZ) = 30
     action_scale_rad: between(0.0, 1.0, above=True) = 0.2
     start_jitter: bool = True
+    draws: DrawsSpec | None = None        # None: SWIM's setting, the pool's three goals in its own water
 
     @field_validator("policy_hz")
     @classmethod
@@ -113,6 +158,9 @@ class RunSpec(Strict):
     checkpoint_every: count(1, 1_000_000) = 1    # epochs between checkpoints
     seed: count(0, 2**31 - 1) = 0
     workers: count(1, 64) = 2
+    # A policy file whose network and normaliser the training starts from (a curriculum's next
+    # stage), relative to the configuration file; None: a fresh network.
+    start_from: str | None = None
 
 
 class TrainSpec(Strict):
@@ -142,4 +190,10 @@ def load_train_spec(path: str | Path | None, overrides: list[str] = ()) -> Train
             node[parts[-1]] = yaml.safe_load(text)
         except yaml.YAMLError:
             raise ConfigError(f"--set {key}: cannot read the value {text!r}") from None
-    return parse(TrainSpec, data, f"{source}{' with --set' if overrides else ''}")
+    spec = parse(TrainSpec, data, f"{source}{' with --set' if overrides else ''}")
+    if spec.run.start_from is not None:
+        start = source.parent / spec.run.start_from     # an absolute start_from stays as it is
+        if not start.is_file():
+            raise ConfigError(f"{source}: run.start_from: no policy file {start}")
+        spec = spec.model_copy(update={"run": spec.run.model_copy(update={"start_from": str(start.resolve())})})
+    return spec

@@ -7,13 +7,16 @@ physics steps until the next one.
   layered controller (steering, rules) underneath.
 - ``reset(options={"goal": k, "start_seed": s})`` picks the goal (else drawn) and the start:
   seed 0 is SWIM's fixed start, others jitter it (``episode.jittered_start``); with
-  ``start_jitter`` every reset draws a jittered start.
+  ``start_jitter`` every reset draws a jittered start, from seeds at ``TRAINING_SEEDS`` and up
+  (the ones below are evaluation's). With ``draws`` (``DrawsSpec``) a reset that names no goal
+  draws the episode's pool, goal, current, density and push; one that names it draws nothing.
 - Observation: ``observation.py`` (``env.layout`` names its slices). Action: one value in
   [-1, 1] per pose coordinate (``env.action_names``), times ``action_scale_rad``.
 - Reward: SWIM's task x stability + smoothness (``reward.py``), every part in ``info["reward"]``.
-- The pool's horizon ends an episode by truncation. Leaving the pool, sinking to its floor or a
-  simulation that blows up terminates it, with the reason in ``info["termination"]``. The last
-  step's ``info["metrics"]`` holds the task's Pos, Prog, Dev and Roll.
+- The goal's horizon ends an episode by truncation. Leaving the pool, sinking to its floor (the
+  goal task's ``ended``, as for every controller) or a simulation that blows up terminates it,
+  with the reason in ``info["termination"]``. The last step's ``info["metrics"]`` holds the
+  task's Pos, Prog, Dev and Roll over the whole horizon, and whether it was a success.
 """
 from __future__ import annotations
 
@@ -29,7 +32,7 @@ from layered_swim.control.residual import ResidualController
 from layered_swim.control.steering import attitude_of
 from layered_swim.fluid import FluidError
 from layered_swim.rl import observation as obs
-from layered_swim.rl.config import RewardSpec
+from layered_swim.rl.config import DrawsSpec, RewardSpec
 from layered_swim.rl.reward import BODY_POINT_WEIGHTS, reward_parts
 from layered_swim.runs import goal_episode
 from layered_swim.sim.simulation import SimulationDiverged
@@ -38,6 +41,13 @@ from layered_swim.state import BodyState
 from layered_swim.tasks import swim_benchmark as bench
 
 REFERENCES = {"basic": "basic", "layered": "basic,cycle,rules"}
+TRAINING_SEEDS = 1000       # jittered starts drawn in training start here; evaluation uses the seeds below
+
+
+class Push(NamedTuple):
+    force_n: np.ndarray         # world frame, on the pelvis
+    from_s: float
+    to_s: float
 
 
 class Observed(NamedTuple):
@@ -104,15 +114,18 @@ class SwimGoalEnv(gym.Env):
                  env_state: str = "SmoothFT", policy_hz: int = 30, action_scale_rad: float = 0.2,
                  reward_weights: RewardSpec | dict = RewardSpec(), backend: str = "plate", fluid_settings=None,
                  current_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0), goal: int | None = None,
-                 start_jitter: bool = False, density_kg_m3: float | None = None):
+                 start_jitter: bool = False, density_kg_m3: float | None = None,
+                 draws: DrawsSpec | dict | None = None):
         if isinstance(reward_weights, dict):     # gym.make's keyword arguments: checked like the YAML's reward section
             reward_weights = parse(RewardSpec, reward_weights, "the environment's reward_weights")
+        if isinstance(draws, dict):
+            draws = parse(DrawsSpec, draws, "the environment's draws")
         if reference not in REFERENCES:
             raise ConfigError(f"reference must be one of {', '.join(REFERENCES)}, got {reference!r}")
         if not (isinstance(action_scale_rad, (int, float)) and 0.0 < action_scale_rad <= 1.0):
             raise ConfigError(f"action_scale_rad must be in (0, 1] rad, got {action_scale_rad!r}")
-        self.pool = bench.pool(pool)
         self.reference, self.env_state, self.action_scale_rad = reference, env_state, float(action_scale_rad)
+        self.draws = draws
         self.reward_weights, self.fixed_goal, self.start_jitter = reward_weights, goal, start_jitter
         spec = SwimSpec.of("the environment", stroke=stroke, task={"kind": "goal", "pool": pool},
                            medium={"current_m_s": current_m_s, "density_kg_m3": density_kg_m3},
@@ -123,6 +136,9 @@ class SwimGoalEnv(gym.Env):
         if not (isinstance(policy_hz, int) and policy_hz > 0 and sim.config.physics_hz % policy_hz == 0
                 and (sim.config.physics_hz // policy_hz) % sim.control_every == 0):
             raise ConfigError(f"policy_hz must divide the control rate {sim.config.control_hz} Hz, got {policy_hz!r}")
+        self.water = sim.fluid.medium        # the water a reset that draws nothing swims in
+        self.weight_n = self.episode.body.total_mass_kg * abs(sim.config.gravity_m_s2)
+        self.push: Push | None = None
         self.physics_per_action = sim.config.physics_hz // policy_hz
         self.dt_s = 1.0 / policy_hz
         self.roll_tolerance_rad = math.radians(bench.ROLL_TOLERANCE_DEG.get(self.episode.stroke.name, 45.0))
@@ -142,12 +158,21 @@ class SwimGoalEnv(gym.Env):
         super().reset(seed=seed)
         options = options or {}
         goal = options.get("goal", self.fixed_goal)
-        if goal is None:
-            goal = int(self.np_random.integers(len(self.episode.task.goals)))
-        start_seed = options.get("start_seed", int(self.np_random.integers(1, 2**31)) if self.start_jitter else 0)
-        self.episode.reset(seed=start_seed, goal=goal)      # seed 0: exactly SWIM's start; others jitter it
-        self.input.reset()
+        drawn = self.draws is not None and goal is None
+        if drawn:
+            aim = {"goal_task": self._draw_goal()}
+        else:
+            if goal is None:
+                goal = int(self.np_random.integers(len(self.episode.task.goals)))
+            aim = {"goal": goal}
+        start_seed = options.get("start_seed", int(self.np_random.integers(TRAINING_SEEDS, 2**31))
+                                 if self.start_jitter else 0)
         sim = self.episode.sim
+        if self.draws is not None:      # before the reset, whose first wrenches are this water's
+            sim.fluid.set_medium(self._draw_water() if drawn else self.water)
+        self.episode.reset(seed=start_seed, **aim)      # seed 0: exactly SWIM's start; others jitter it
+        self.input.reset()
+        self.push = self._draw_push() if drawn else None
         self._last_obs = self._observe(sim.fluid_now.force_n, sim.fluid_now.torque_nm)
         self._rates = self.input.now.joint_rates
         return self._last_obs.copy(), {"goal": goal, "goal_m": list(self.episode.task.goal.goal_m)}
@@ -160,13 +185,18 @@ class SwimGoalEnv(gym.Env):
         sim.controller.set_residual(self.action_scale_rad * action)
         force, torque = np.zeros_like(sim.fluid_now.force_n), np.zeros_like(sim.fluid_now.torque_nm)
         clock = time.perf_counter()
+        push = self.push
         try:
             for _ in range(self.physics_per_action):
+                if push is not None:
+                    sim.push(push.force_n if push.from_s <= sim.time_s < push.to_s else 0.0)
                 episode.step()
                 force += sim.fluid_now.force_n
                 torque += sim.fluid_now.torque_nm
         except (SimulationDiverged, FluidError) as err:
-            return self._last_obs.copy(), 0.0, True, False, {"termination": f"diverged: {err}"}
+            episode.task.end(f"diverged: {err}", sim.time_s)
+            return self._last_obs.copy(), 0.0, True, False, {"termination": episode.task.ended,
+                                                              "metrics": episode.metrics()}
         observed = time.perf_counter()
         force /= self.physics_per_action
         torque /= self.physics_per_action
@@ -180,8 +210,8 @@ class SwimGoalEnv(gym.Env):
         self.timing["observation_s"] += rewarded - observed
         self.timing["reward_s"] += done - rewarded
         info: dict[str, Any] = {"reward": parts, "time_s": sim.time_s}
-        reason = self._failure(sim.state.com_m)
-        truncated = reason is None and sim.time_s >= self.pool.horizon_s - 1e-9
+        reason = episode.task.ended
+        truncated = reason is None and sim.time_s >= episode.task.duration_s - 1e-9
         if reason is not None:
             info["termination"] = reason
         if reason is not None or truncated:
@@ -205,10 +235,28 @@ class SwimGoalEnv(gym.Env):
                             task.direction, now.goal_yaws_rad, now.roll_rad, self.roll_tolerance_rad, joint_accel,
                             self.reward_weights)
 
-    def _failure(self, com_m: np.ndarray) -> str | None:
-        x0, x1 = self.pool.x_range_m
-        if not (x0 < com_m[0] < x1 and abs(com_m[1]) < self.pool.width_m / 2):
-            return f"left the {self.pool.name} pool (centre of mass at x = {com_m[0]:.2f}, y = {com_m[1]:.2f} m)"
-        if com_m[2] < -self.pool.depth_m:
-            return f"sank to the floor of the {self.pool.depth_m:g} m deep pool"
-        return None
+    # -- draws (training only) --------------------------------------------------------------
+    def _draw_goal(self) -> bench.GoalTask:
+        rng, draws = self.np_random, self.draws
+        pool = bench.pool(draws.pools[int(rng.integers(len(draws.pools)))])
+        if draws.goal_bearing_deg == 0.0:
+            goals = bench.goal_tasks(pool)
+            return goals[int(rng.integers(len(goals)))]
+        bearing = math.radians(rng.uniform(-draws.goal_bearing_deg, draws.goal_bearing_deg))
+        return bench.goal_tasks(pool.holding(pool.goal_distance_m * math.tan(bearing)))[0]
+
+    def _draw_water(self):
+        rng, draws = self.np_random, self.draws
+        speed, towards = draws.current_m_s.draw(rng), rng.uniform(0.0, 2.0 * math.pi)
+        water = self.water.with_(current_m_s=(speed * math.cos(towards), speed * math.sin(towards), 0.0))
+        return water if draws.density_kg_m3 is None else water.with_(rho_kg_m3=draws.density_kg_m3.draw(rng))
+
+    def _draw_push(self) -> Push | None:
+        rng, draws = self.np_random, self.draws
+        if rng.uniform() >= draws.push_chance:
+            return None
+        direction = rng.normal(size=3)
+        force = draws.push_body_weights.draw(rng) * self.weight_n * direction / np.linalg.norm(direction)
+        length_s = draws.push_s.draw(rng)
+        start_s = rng.uniform(0.5, max(0.5, self.episode.task.duration_s - length_s - 0.5))
+        return Push(force, start_s, start_s + length_s)

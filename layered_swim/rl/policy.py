@@ -123,9 +123,16 @@ def model_arguments(value, source) -> ModelArgs:
     return ModelArgs(n_obs, n_act, tuple(hidden), float(log_std))
 
 
+# Fields added after policies were shipped, whose default is what every earlier file trained with.
+LATER_FIELDS = {"draws": None}
+
+
 def section(spec, data, name: str, source):
     """A file's ``env`` or ``reward`` section as the training configuration's ``spec`` (EnvSpec,
-    RewardSpec), complete (a default filled in would change what the policy was trained for)."""
+    RewardSpec), complete (a default filled in would change what the policy was trained for),
+    but for ``LATER_FIELDS``, which a file written before them lacks."""
+    if isinstance(data, dict):
+        data = {**{k: v for k, v in LATER_FIELDS.items() if k in spec.model_fields}, **data}
     check_keys(data, spec.model_fields, name, source)
     return parse(spec, data, f"{source}: {name}")
 
@@ -144,7 +151,8 @@ def env_arguments(env: EnvSpec, reward: RewardSpec, **changes) -> dict:
 def evaluate_goals(policy: ResidualPolicy, seeds: int = 5, goals: list[int] | None = None, **env_changes) -> dict:
     """The policy, deterministic, on each of ``goals`` (default: all the pool's) from ``seeds``
     starts (seed 0: SWIM's fixed start; the others jittered): Pos, Prog, Dev and Roll per run
-    and their means."""
+    (over the whole horizon, an episode that ended early held where it stopped), their means and
+    the share of runs that swam to the end."""
     from layered_swim.rl.rollouts import make_env, play
 
     env = make_env(policy.env_kwargs(**{"start_jitter": False, **env_changes}))
@@ -160,9 +168,9 @@ def evaluate_goals(policy: ResidualPolicy, seeds: int = 5, goals: list[int] | No
                          "termination": episode.info.get("termination")})
     finally:
         env.close()
-    complete = [r for r in runs if all(k in r for k in GOAL_METRICS)]
-    mean = {k: float(np.mean([r[k] for r in complete])) if complete else None for k in GOAL_METRICS}
-    return {**mean, "runs": runs, "terminated": sum(r["termination"] is not None for r in runs)}
+    mean = {k: float(np.mean([r[k] for r in runs])) for k in GOAL_METRICS}    # every run scored to its horizon
+    return {**mean, "success_rate": float(np.mean([r["success"] for r in runs])), "runs": runs,
+            "terminated": sum(r["termination"] is not None for r in runs)}
 
 
 class ResidualDriver:

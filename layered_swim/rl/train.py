@@ -58,11 +58,23 @@ class Trainer:
         self.model = ActorCritic(*self.model_args)
         self.optimiser = torch.optim.Adam(self.model.parameters(), lr=spec.ppo.learning_rate)
         self.normaliser = Normaliser(n_obs)
+        if spec.run.start_from is not None:
+            self._start_from(spec.run.start_from)
         self.buffer = EpisodeBuffer(spec.buffer)
         self.rng = np.random.default_rng(spec.run.seed)
         self.generator = torch.Generator().manual_seed(spec.run.seed)
         self.epoch, self.samples, self.wall_s = 0, 0, 0.0
         self.ray_address = ray_address
+
+    def _start_from(self, path: str) -> None:
+        """The network and normaliser of a trained policy of the same shape (a curriculum's earlier stage)."""
+        start = ResidualPolicy.load(path)
+        shape = ("n_obs", "n_act", "hidden")        # its learnt noise replaces init_log_std
+        if [getattr(start.model_args, k) for k in shape] != [getattr(self.model_args, k) for k in shape]:
+            raise ConfigError(f"{path}: run.start_from has another network ({start.model_args}) than this "
+                              f"configuration builds ({self.model_args})")
+        self.model.load_state_dict(start.model.state_dict())
+        self.normaliser.load_state_dict(start.normaliser.state_dict())
 
     # -- checkpoints ----------------------------------------------------------------------
     def policy(self) -> ResidualPolicy:

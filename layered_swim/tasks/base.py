@@ -45,6 +45,7 @@ class SampleLog:
 class Task:
     name = "task"
     target: Target | None = None
+    ended: str | None = None       # why the task ended the episode early (the goal task's pool walls)
 
     def reset(self, episode, rng: np.random.Generator, **options) -> Start:
         """Prepare a new episode of ``episode`` (its stroke, body and controller are built);

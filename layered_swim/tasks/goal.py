@@ -8,7 +8,7 @@ import numpy as np
 from layered_swim.state import Start
 from layered_swim.tasks import swim_benchmark as bench
 from layered_swim.tasks.base import moved_start
-from layered_swim.tasks.follow import FollowTarget
+from layered_swim.tasks.follow import TRACK_HZ, FollowTarget
 
 GOAL_METRICS = ("pos_m", "prog", "dev_m", "roll_deg")
 
@@ -28,14 +28,22 @@ class ScheduledGoal:
 
 
 class GoalReaching(FollowTarget):
-    """One of ``pool``'s goals per episode: ``reset(goal=k)`` picks goal k, else the episode's
-    random generator draws one. The episode lasts the pool's horizon (``duration_s``)."""
+    """One of ``pool``'s goals per episode: ``reset(goal=k)`` picks goal k, ``reset(goal_task=t)``
+    swims ``t`` (a goal of another pool: a training draw, a sweep's), else the episode's random
+    generator draws one of the pool's. The episode lasts the goal's horizon (``duration_s``).
+
+    The pool's walls and floor end an episode (``ended``: why, ``ended_s``: when) for every
+    controller alike, unless ``ends_at_walls`` is off (a sweep in boundless water). The metrics
+    score the whole horizon either way: an episode that ended early is held where it stopped
+    (``bench.held_to``), and only one that swam the horizon counts as a ``success``."""
 
     name = "goal"
+    ends_at_walls = True
 
     def __init__(self, pool: bench.Pool):
         self.pool = pool
         self.goals = bench.goal_tasks(pool)
+        self.ended = self.ended_s = None
         super().__init__(ScheduledGoal(self.goals[0]))
 
     @property
@@ -44,19 +52,39 @@ class GoalReaching(FollowTarget):
 
     @property
     def duration_s(self) -> float:
-        return self.pool.horizon_s
+        return self.goal.duration_s
 
-    def reset(self, episode, rng, goal: int | None = None, **options) -> Start:
-        index = int(rng.integers(len(self.goals))) if goal is None else goal
-        if not 0 <= index < len(self.goals):
-            raise ValueError(f"goal must be in 0..{len(self.goals) - 1}, got {goal}")
-        self.target.goal = self.goals[index]
+    def reset(self, episode, rng, goal: int | None = None, goal_task: bench.GoalTask | None = None,
+              **options) -> Start:
+        if goal_task is None:
+            index = int(rng.integers(len(self.goals))) if goal is None else goal
+            if not 0 <= index < len(self.goals):
+                raise ValueError(f"goal must be in 0..{len(self.goals) - 1}, got {goal}")
+            goal_task = self.goals[index]
+        self.target.goal = goal_task
         self.target.lead_s = episode.stroke.period_s / 2
+        self.ended = self.ended_s = None
         super().reset(episode, rng)
         return moved_start(episode.stroke.start_state(), self.goal.start_m[:2], self.goal.speed_m_s)
+
+    def observe(self, sim) -> None:
+        if sim.steps % self._every:
+            return
+        super().observe(sim)
+        if self.ended is None and self.ends_at_walls:
+            reason = self.goal.pool.ending(self._samples["swimmer_m"][-1])
+            if reason is not None:
+                self.end(reason, sim.time_s)
+
+    def end(self, reason: str, time_s: float) -> None:
+        """The episode ends here (the pool's walls, a simulation that blew up): ``Episode.run`` stops."""
+        if self.ended is None:
+            self.ended, self.ended_s = reason, time_s
 
     def metrics(self) -> dict:
         a = self.track()
         scores = bench.episode_metrics(self.goal, a["track_time_s"], a["swimmer_m"], np.degrees(a["roll_rad"]),
-                                       bench.ROLL_TOLERANCE_DEG.get(self._stroke, 45.0))
-        return {"goal_m": [float(v) for v in self.goal.goal_m], **{k: scores[k] for k in GOAL_METRICS}}
+                                       bench.ROLL_TOLERANCE_DEG.get(self._stroke, 45.0), ended_s=self.ended_s,
+                                       step_s=1.0 / TRACK_HZ)
+        return {"goal_m": [float(v) for v in self.goal.goal_m], **{k: scores[k] for k in GOAL_METRICS},
+                "success": self.ended is None, "ended": self.ended, "ended_s": self.ended_s}

@@ -8,7 +8,7 @@ eq. 3), so every distance here is horizontal: depth is the stroke's business, no
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -22,6 +22,7 @@ START_DEPTH_M = 0.05
 # but never given. Front crawl: the low end of elite shoulder roll, 45-60 deg per side
 # (Psycharakis & Sanders 2010, layered_swim/reference.md section 3); breaststroke barely rolls.
 ROLL_TOLERANCE_DEG = {"front_crawl": 45.0, "breaststroke": 15.0}
+SIDE_ROOM_M = 0.5      # a goal off the pool's own three stays this far inside the side walls
 
 
 @dataclass(frozen=True)
@@ -41,6 +42,22 @@ class Pool:
     def x_range_m(self) -> tuple[float, float]:
         back = -(self.length_m - self.goal_distance_m) / 2
         return back, back + self.length_m
+
+    def ending(self, com_m) -> str | None:
+        """Why a swim with its centre of mass at ``com_m`` ends here (out past a wall, down on the
+        floor), or None while it is inside the pool. Every controller's episode ends the same way."""
+        x0, x1 = self.x_range_m
+        if not (x0 < com_m[0] < x1 and abs(com_m[1]) < self.width_m / 2):
+            return f"left the {self.name} pool (centre of mass at x = {com_m[0]:.2f}, y = {com_m[1]:.2f} m)"
+        if com_m[2] < -self.depth_m:
+            return f"sank to the floor of the {self.depth_m:g} m deep pool"
+        return None
+
+    def holding(self, lateral_m: float, side_room_m: float = SIDE_ROOM_M) -> "Pool":
+        """This pool with one goal ``lateral_m`` to the left of straight ahead, widened where needed
+        to keep it ``side_room_m`` inside the side walls (SWIM's Fig. 4 sweep; goals drawn in training)."""
+        return replace(self, name=f"{self.name} (goal {lateral_m:+.2f} m left)", goal_offsets_m=(float(lateral_m),),
+                       width_m=max(self.width_m, 2.0 * (abs(lateral_m) + side_room_m)))
 
 
 # The paper's numbers, worked back: Fig. 4 puts d_lat = 1.0 m at 18.4 deg and 1.25 m at 22.6 deg
@@ -184,19 +201,41 @@ def straight_line_metrics(time_s, positions, roll_deg, start, direction, speed_m
     }
 
 
-def episode_metrics(task: GoalTask, time_s, positions, roll_deg, tolerance_deg: float,
-                    joint_vel=None, ref_joint_vel=None) -> dict:
-    """The metrics of one goal-reaching episode. The episode is the task's horizon: samples
-    logged after it are left out (so the schedule never needs holding at the goal)."""
+def held_to(time_s, samples: list, end_s: float, step_s: float) -> tuple[np.ndarray, list]:
+    """The samples with their last one held, every ``step_s``, until ``end_s``: an episode that
+    ended early (out of the pool, sunk, blown up) is scored over the whole horizon, the swimmer
+    staying where it stopped, not over the part it swam. Each of ``samples`` (n, ...) or None."""
     time_s = np.asarray(time_s, dtype=float)
-    keep = time_s <= task.duration_s + 1e-9     # the last sample may sit on the horizon, rounded
+    extra = np.arange(time_s[-1] + step_s, end_s + 1e-9, step_s)
+    if not len(extra):
+        return time_s, samples
 
-    def pick(samples):
-        return None if samples is None else np.asarray(samples, dtype=float)[keep]
+    def hold(values):
+        if values is None:
+            return None
+        values = np.asarray(values, dtype=float)
+        return np.concatenate([values, np.repeat(values[-1:], len(extra), axis=0)])
 
-    return straight_line_metrics(time_s[keep], pick(positions), pick(roll_deg), task.start_m,
-                                 task.direction, task.speed_m_s, tolerance_deg,
-                                 pick(joint_vel), pick(ref_joint_vel))
+    return np.concatenate([time_s, extra]), [hold(v) for v in samples]
+
+
+def episode_metrics(task: GoalTask, time_s, positions, roll_deg, tolerance_deg: float,
+                    joint_vel=None, ref_joint_vel=None, ended_s: float | None = None,
+                    step_s: float | None = None) -> dict:
+    """The metrics of one goal-reaching episode. The episode is the task's horizon: samples
+    logged after it are left out (so the schedule never needs holding at the goal). One that
+    ended at ``ended_s`` is held there to the horizon (``held_to``, every ``step_s``)."""
+    time_s = np.asarray(time_s, dtype=float)
+    end_s = task.duration_s if ended_s is None else min(ended_s, task.duration_s)
+    keep = time_s <= end_s + 1e-9     # the last sample may sit on the horizon, rounded
+    samples = [None if v is None else np.asarray(v, dtype=float)[keep]
+               for v in (positions, roll_deg, joint_vel, ref_joint_vel)]
+    time_s = time_s[keep]
+    if ended_s is not None:
+        time_s, samples = held_to(time_s, samples, task.duration_s, step_s)
+    positions, roll_deg, joint_vel, ref_joint_vel = samples
+    return straight_line_metrics(time_s, positions, roll_deg, task.start_m, task.direction, task.speed_m_s,
+                                 tolerance_deg, joint_vel, ref_joint_vel)
 
 
 def _published(pos, prog_, dev) -> dict:
@@ -219,4 +258,18 @@ SWIM_PUBLISHED = {
         "M-PPO-3": _published((0.349, 0.156), (0.761, 0.099), (0.157, 0.101)),
         "M-PPO-2": _published((0.626, 0.376), (1.102, 0.142), (0.378, 0.470)),
     },
+}
+
+
+# SWIM 2026, Table 3 ("cross-method trajectory tracking", freestyle), all four columns, (mean,
+# std) over targets; "dynamic" is SWIM's water with waves, filtered to four flow directions.
+SWIM_PUBLISHED_TABLE3 = {
+    "3 m static": SWIM_PUBLISHED["small"],
+    "3 m dynamic": {"SWIM": _published((0.254, 0.104), (0.675, 0.316), (0.069, 0.048)),
+                    "M-PPO-3": _published((0.266, 0.126), (0.646, 0.322), (0.061, 0.031)),
+                    "M-PPO-2": _published((0.286, 0.161), (0.696, 0.254), (0.132, 0.148))},
+    "5 m static": SWIM_PUBLISHED["large"],
+    "5 m dynamic": {"SWIM": _published((0.392, 0.211), (0.850, 0.212), (0.169, 0.089)),
+                    "M-PPO-3": _published((0.458, 0.175), (0.774, 0.211), (0.191, 0.149)),
+                    "M-PPO-2": _published((0.874, 0.616), (0.874, 0.423), (0.498, 0.501))},
 }

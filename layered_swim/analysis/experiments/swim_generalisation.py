@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import hashlib
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -95,7 +94,7 @@ QUICK_VISCOSITIES_M2_S = (None, 1e-3, 5e-2)
 SPEEDS_M_S = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5)
 QUICK_SPEEDS_M_S = (0.5, 1.0, 1.5)
 STARTS = 3                 # seed 0: SWIM's fixed start; the others jittered (quick: seed 0 only)
-SIDE_ROOM_M = 0.5          # the lateral sweep's pool is widened to keep its goal this far inside the side walls
+SIDE_ROOM_M = bench.SIDE_ROOM_M    # the lateral sweep keeps its goal this far inside the widened side walls
 HOLD_POS_FACTOR = 2.0      # a point holds while Pos stays within twice the controller's own at the reference
 LABELS = {"pos_m": "Pos (m)", "prog": "Prog (1 = on schedule)", "dev_m": "Dev (m)",
           "roll_deg": "Roll beyond tolerance (deg)"}
@@ -138,16 +137,15 @@ def configs(quick: bool, seed: int) -> list[dict]:
 def sweep_pool(config: dict) -> bench.Pool:
     """The config's pool; for a lateral offset, the pool with that one goal, widened to hold it."""
     pool = bench.pool(config["pool"])
-    if config["d_lat_m"] is None:
-        return pool
-    y = -config["d_lat_m"]
-    return replace(pool, name=f"{pool.name} (d_lat {config['d_lat_m']:+g} m)", goal_offsets_m=(y,),
-                   width_m=max(pool.width_m, 2.0 * (abs(y) + SIDE_ROOM_M)))
+    return pool if config["d_lat_m"] is None else pool.holding(-config["d_lat_m"], SIDE_ROOM_M)
 
 
 def _aim(episode, pool: bench.Pool) -> None:
-    """Point the episode's goal task at ``pool``'s goals (a pool of the sweep, not one of the named two)."""
+    """Point the episode's goal task at ``pool``'s goals (a pool of the sweep, not one of the named two),
+    in boundless water: both controllers swim the whole horizon, what the track says of the pool is
+    reported beside (``_outcome``)."""
     episode.task.pool, episode.task.goals = pool, bench.goal_tasks(pool)
+    episode.task.ends_at_walls = False
 
 
 def _set_viscosity(episode, viscosity_m2_s: float | None) -> None:
@@ -197,8 +195,8 @@ def _layered(config: dict, pool: bench.Pool) -> list[dict]:
 
 
 def _residual(config: dict, pool: bench.Pool) -> list[dict]:
-    """The policy in its training environment, in this config's water, on this pool's goal; its own
-    pool checks are off (a boundless pool), so it swims the whole horizon like the heuristic."""
+    """The policy in its training environment, in this config's water, on this pool's goal; its
+    pool's walls are off (``_aim``), so it swims the whole horizon like the heuristic."""
     from layered_swim.rl.policy import ResidualPolicy
     from layered_swim.rl.ppo import ActorSnapshot
     from layered_swim.rl.rollouts import make_env, play
@@ -212,7 +210,6 @@ def _residual(config: dict, pool: bench.Pool) -> list[dict]:
         policy.check_sizes(env.observation_space.shape[0], env.action_space.shape[0], "the goal task")
         _aim(env.episode, pool)
         _set_viscosity(env.episode, config["viscosity_m2_s"])
-        env.pool = replace(pool, length_m=1e6, width_m=1e6, depth_m=1e6)
         actor = ActorSnapshot(policy.model)
         for start in range(config["starts"]):
             option = {"goal": config["goal"], "start_seed": start}
