@@ -29,6 +29,15 @@ POOL = "small"
 # SWIM names the diagonal but not which one: we take downstream-and-across, between +x and +y.
 DIRECTIONS = {"+x downstream": (1.0, 0.0), "-x upstream": (-1.0, 0.0), "+y cross": (0.0, 1.0),
               "diagonal": (math.sqrt(0.5), math.sqrt(0.5))}
+
+
+def current_m_s(direction: str, speed_m_s: float) -> list[float]:
+    """The uniform current of ``speed_m_s`` flowing toward one of ``DIRECTIONS`` (still water: zeros)."""
+    if not speed_m_s:
+        return [0.0, 0.0, 0.0]
+    return [speed_m_s * DIRECTIONS[direction][0], speed_m_s * DIRECTIONS[direction][1], 0.0]
+
+
 SPEEDS_M_S = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5)
 QUICK_SPEEDS_M_S = (0.5, 1.0, 1.5)
 STRUGGLE_POS_FACTOR = 2.0     # "struggles": Pos more than twice its quiet-water value
@@ -41,7 +50,7 @@ def configs(quick: bool, seed: int) -> list[dict]:
     goals = range(len(bench.pool(POOL).goal_offsets_m))
     flows = [("quiet", 0.0)] + [(d, s) for d in DIRECTIONS for s in (QUICK_SPEEDS_M_S if quick else SPEEDS_M_S)]
     return [{"stroke": STROKE, "pool": POOL, "goal": g, "direction": d, "speed_m_s": s,
-             "current_m_s": [s * DIRECTIONS[d][0], s * DIRECTIONS[d][1], 0.0] if s else [0.0, 0.0, 0.0]}
+             "current_m_s": current_m_s(d, s)}
             for d, s in flows for g in goals]
 
 

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from layered_swim.analysis import plots
-from layered_swim.analysis.experiments.current_sweep import DIRECTIONS
+from layered_swim.analysis.experiments.current_sweep import DIRECTIONS, current_m_s
 from layered_swim.analysis.experiments.runner import Outcome
 from layered_swim.config import ConfigError
 from layered_swim.fluid.medium import PRESETS_KG_M3_PA_S
@@ -112,8 +112,7 @@ def theta_lat_deg(d_lat_m: float) -> float:
 
 def _condition(pool: str = "small", goal: int = 0, d_lat_m: float | None = None, density_kg_m3: float = FRESH_KG_M3,
                viscosity_m2_s: float | None = None, direction: str = "quiet", speed_m_s: float = 0.0) -> dict:
-    current = [speed_m_s * DIRECTIONS[direction][0], speed_m_s * DIRECTIONS[direction][1], 0.0] if speed_m_s \
-        else [0.0, 0.0, 0.0]
+    current = current_m_s(direction, speed_m_s)
     return {"pool": pool, "goal": goal, "d_lat_m": d_lat_m, "density_kg_m3": density_kg_m3,
             "viscosity_m2_s": viscosity_m2_s, "direction": direction, "speed_m_s": speed_m_s, "current_m_s": current}
 

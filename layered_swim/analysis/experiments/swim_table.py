@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from layered_swim.analysis import plots
-from layered_swim.analysis.experiments.current_sweep import DIRECTIONS
+from layered_swim.analysis.experiments.current_sweep import DIRECTIONS, current_m_s
 from layered_swim.analysis.experiments.runner import Outcome
 from layered_swim.config import ConfigError
 from layered_swim.tasks import swim_benchmark as bench
@@ -62,7 +62,7 @@ def currents(water: str, quick: bool) -> list[list[float]]:
     if water == "quiet":
         return [[0.0, 0.0, 0.0]]
     flows = [("+y cross", 0.3)] if quick else [(d, s) for d in DIRECTIONS for s in FLOW_SPEEDS_M_S]
-    return [[s * DIRECTIONS[d][0], s * DIRECTIONS[d][1], 0.0] for d, s in flows]
+    return [current_m_s(d, s) for d, s in flows]
 
 
 def configs(quick: bool, seed: int) -> list[dict]:
