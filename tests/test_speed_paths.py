@@ -1,12 +1,18 @@
 """The physics step's fast paths give numpy's own bits: the compiled single-quaternion rotation
-and cross product, and the one-call wrench + stable PD loads."""
+and cross product, the one-call wrench + stable PD loads, the compiled hand rules and the goal
+line's one-time position."""
+import math
+
 import numpy as np
 
 from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import load_body
+from layered_swim.control.rules import RULE_MEMORY_S, arm_indices, rule_offsets
+from layered_swim.control.stroke import RulesSpec
 from layered_swim.geometry import cross, quat_rotate, unit_vector
 from layered_swim.sim.simulation import PRONE_QUAT_XYZW
 from layered_swim.sim.world import World
+from layered_swim.tasks import swim_benchmark as bench
 
 
 def _numpy_rotate(q, v):
@@ -51,3 +57,52 @@ def test_one_call_loads_equal_wrenches_then_drive():
         finally:
             world.close()
     assert pending[0].tobytes() == pending[1].tobytes()
+
+
+def _numpy_rules(previous, arms, rules, quat, linvel, flow_m_s, desired, dt_s, engagement):
+    """The hand rules as numpy vector expressions (the compiled kernel's reference)."""
+    pull, limit = np.zeros_like(previous), np.zeros_like(previous)
+    for arm in arms:
+        flow = flow_m_s[arm.hand] - linvel[arm.hand]
+        speed = math.sqrt(flow.dot(flow))
+        if speed < 0.05:
+            continue
+        flow_dir = flow / speed
+        helpfulness, strength = float(flow_dir @ desired), min(speed, 1.0)
+        if helpfulness > 0.0 or rules.palm.hindering:
+            normal = _numpy_rotate(quat[arm.hand], np.array([0.0, 1.0, 0.0]))
+            turning = np.cross(_numpy_rotate(quat[arm.forearm], arm.wrist_axes), normal)
+            facing, along = float(normal @ flow_dir), float(normal @ desired)
+            gradient = 2.0 * abs(facing) * along * (turning @ flow_dir) + facing * abs(facing) * (turning @ desired)
+            pull[list(arm.palm_coords)] = rules.palm.gain * strength * gradient
+            limit[list(arm.palm_coords)] = np.radians(rules.palm.max_deg)
+        if helpfulness > 0.0 or rules.reach.hindering:
+            pull[arm.elbow_coord] = -rules.reach.gain * helpfulness * strength
+            limit[arm.elbow_coord] = np.radians(rules.reach.max_deg)
+    return np.clip(previous * (1.0 - dt_s / RULE_MEMORY_S) + engagement * pull * dt_s, -limit, limit)
+
+
+def test_compiled_hand_rules_are_numpys_bits():
+    body = load_body()
+    layout = joint_layout(body)
+    arms, rules = arm_indices(body, layout), RulesSpec()
+    rng = np.random.default_rng(5)
+    n = len(body.segment_names)
+    for k in range(500):
+        quat = rng.normal(size=(n, 4))
+        quat /= np.linalg.norm(quat, axis=1, keepdims=True)
+        linvel, flow = rng.normal(size=(n, 3)), rng.normal(size=(n, 3)) * (k % 3)   # some steps in still water
+        desired = rng.normal(size=3)
+        desired /= np.linalg.norm(desired)
+        previous = rng.normal(size=layout.size) * 0.3
+        args, engagement = (previous, arms, rules, quat, linvel, flow, desired, 1.0 / 120.0), rng.uniform()
+        assert rule_offsets(*args, engagement=engagement).tobytes() == _numpy_rules(*args, engagement).tobytes()
+
+
+def test_the_goal_lines_one_time_position_is_the_arrays():
+    task = bench.goal_tasks(bench.pool("small"))[2]
+    for t_s in (0.0, 0.37, 1.9, task.duration_s, task.duration_s + 2.0):
+        one = bench.goal_position(task, float(t_s))
+        assert one.tobytes() == bench.goal_position(task, np.array([t_s]))[0].tobytes()
+        assert bench.intermediate_goal(task, float(t_s), 0.5).tobytes() == \
+            bench.intermediate_goal(task, np.array(t_s), 0.5).tobytes()

@@ -17,7 +17,7 @@ import numpy as np
 
 from layered_swim.config import ConfigError
 from layered_swim.control.lungs import LungControl
-from layered_swim.control.rules import ArmIndices, rule_offsets
+from layered_swim.control.rules import Arms, rule_offsets
 from layered_swim.control.steering import forward_axis, shoulder_roll
 from layered_swim.control.stroke import ALL_SEQUENCES, Stroke
 from layered_swim.control.targets import Target
@@ -69,7 +69,7 @@ class CycleChooser(Protocol):
 
 
 class LayeredController:
-    def __init__(self, stroke: Stroke, layout: JointLayout, arms: list[ArmIndices], chooser: CycleChooser,
+    def __init__(self, stroke: Stroke, layout: JointLayout, arms: Arms, chooser: CycleChooser,
                  layers: Layers = Layers(), target: Target | None = None, lungs: LungControl | None = None):
         """``target``: where the rules push toward; without one, straight ahead (scripted weights).
         ``lungs``: breathe toward the target's depth (needs a target)."""

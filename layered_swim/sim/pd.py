@@ -107,16 +107,17 @@ def stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt):
 
 @njit(cache=True)
 def loads_and_pd(index, params, frames, s, rows, force, torque, at, q, qd, target_q, target_qd, gains, dt,
-                 gravity_m_s2):
+                 gravity_m_s2, base_wrench, tau, total):
     """One call for a physics step's joint-space loads: the generalised forces of one wrench per
     body (``articulation.generalized_forces``), the stable PD torques (``stable_pd_torques`` on
     ``articulation.mass_matrix_and_bias``) and their sum on the joints' rates (zero on the base's,
     whose wrench PyBullet takes apart). The same arithmetic as the three calls one by one: the
-    same bits, a third of the call overhead. Returns (wrench loads, PD torques, joint total)."""
+    same bits, a third of the call overhead. Writes the base's wrench (moment; force) into
+    ``base_wrench`` (6,), the PD torques into ``tau`` and the joints' total into ``total``
+    (n_dof,): arrays a call returns cost Python more than these kernels' own arithmetic."""
     load = generalized_forces(index, frames, s, rows, force, torque, at)
     mass, bias = mass_matrix_and_bias(index, params, frames, s, gravity_m_s2)
-    tau = stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt)
-    total = np.empty(tau.shape[0])
+    tau[:] = stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt)
     for k in range(tau.shape[0]):
         total[k] = (load[k] if k >= 6 else 0.0) + tau[k]
-    return load, tau, total
+    base_wrench[:] = load[0:6]

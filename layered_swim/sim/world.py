@@ -164,7 +164,9 @@ class World:
         self._qd_at, self._qd_from = np.array(qd_at), np.array(qd_from)
         self._target_q = np.zeros(tree.n_positions)
         self._target_qd = np.zeros(tree.n_dof)
-        self._torque = np.zeros(tree.n_dof)
+        self._torque = np.zeros(tree.n_dof)      # the PD torques of the last step
+        self._total = np.zeros(tree.n_dof)       # the step's joint loads, written in place each step
+        self._base_wrench = np.zeros(6)
         self._pending: np.ndarray | None = None   # generalised forces for the next step: PD and wrenches
         self._walls: list[int] = []                # static bodies of a pool the swimmer touches
 
@@ -275,13 +277,14 @@ class World:
         the same loads to the same bits."""
         self._ensure_fresh()
         tree = self.tree
-        load, self._torque, total = loads_and_pd(tree.index, tree.params, self._frames, self._subspace,
-                                                 self._segment_rows, force_n, torque_nm, at_m, self._q, self._qd,
-                                                 self._target_q, self._target_qd, self._gains, self.dt_s,
-                                                 self.gravity_m_s2)
+        base, total = self._base_wrench, self._total
+        loads_and_pd(tree.index, tree.params, self._frames, self._subspace, self._segment_rows, force_n, torque_nm,
+                     at_m, self._q, self._qd, self._target_q, self._target_qd, self._gains, self.dt_s,
+                     self.gravity_m_s2, base, self._torque, total)
         uid, cid, frame = self.uid, self._cid, pybullet.WORLD_FRAME
-        pybullet.applyExternalForce(uid, -1, load[3:6].tolist(), self._q[0:3].tolist(), frame, cid)
-        pybullet.applyExternalTorque(uid, -1, load[0:3].tolist(), frame, cid)
+        wrench = base.tolist()
+        pybullet.applyExternalForce(uid, -1, wrench[3:6], self._q[0:3].tolist(), frame, cid)
+        pybullet.applyExternalTorque(uid, -1, wrench[0:3], frame, cid)
         self._add_pending(total)
 
     def set_targets(self, pose: np.ndarray, rates: np.ndarray) -> None:
