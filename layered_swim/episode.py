@@ -223,7 +223,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                     glide_cycles=steer.glide_cycles, turn_tempo=steer.turn_tempo,
                                     turn_tempo_until_ahead_s=steer.turn_tempo_until_ahead_s,
                                     wide_turn_rad=math.radians(steer.wide_turn_deg))
-                lead = Lead(bend_s=steer.lead_bend_s, wait_ahead_s=steer.wait_ahead_s)
+                lead = Lead(bend_s=steer.lead_bend_s, wait_ahead_s=steer.wait_ahead_s,
+                            wait_within_m=steer.wait_within_m, aim_off=steer.aim_off)
             gains = SteeringGains(steer.yaw_fraction, steer.pitch_fraction, steer.roll_fraction,
                                   over_weight_within_rad=math.radians(steer.over_weight_within_deg))
             level_off = (math.radians(steer.level_off_beyond_deg)

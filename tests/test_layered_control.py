@@ -9,7 +9,7 @@ from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, load
 from layered_swim.control.calibration import CalibrationTable, Pace, load_table
-from layered_swim.control.cycle_choice import Lead, TargetChooser, TempoControl
+from layered_swim.control.cycle_choice import Drift, Lead, TargetChooser, TempoControl
 from layered_swim.control.layered import CycleChoice, LayeredController, Layers, fixed_weights
 from layered_swim.control.rules import arm_indices, rule_offsets
 from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, wanted_turns
@@ -388,13 +388,14 @@ def test_lead_looks_further_ahead_where_the_path_bends():
 def test_lead_aims_from_the_swimmers_own_place_on_the_path_when_it_is_ahead():
     line = load_trajectory("straight_line")          # x = 2 + 0.5 t, y = 0, 0.3 m deep
     lead = Lead(straight_s=1.5, bend_s=3.0)
-    aim, ahead_s = lead.aim(line, 0.0, np.array([0.0, 0.5, -0.3]))      # behind: aims 1.5 s past the target
+    aim, ahead_s, off_m = lead.aim(line, 0.0, np.array([0.0, 0.5, -0.3]))     # behind: aims 1.5 s past the target
     # 2 m behind a target that waited at its start before t = 0: as far behind as the search looks.
     assert ahead_s == pytest.approx(-lead.search_s) and aim == pytest.approx([2.75, 0.0, -0.3])
-    aim, ahead_s = lead.aim(line, 4.0, np.array([3.0, 0.5, -0.3]))      # 1 m (2 s) behind the target at x = 4
-    assert ahead_s == pytest.approx(-2.0) and aim == pytest.approx([4.75, 0.0, -0.3])
-    aim, ahead_s = lead.aim(line, 0.0, np.array([4.0, 1.0, -0.3]))      # 2 m (4 s) ahead of it, off the line
-    assert ahead_s == pytest.approx(4.0) and aim == pytest.approx([4.75, 0.0, -0.3])
+    assert off_m == pytest.approx(math.hypot(2.0, 0.5))
+    aim, ahead_s, off_m = lead.aim(line, 4.0, np.array([3.0, 0.5, -0.3]))     # 1 m (2 s) behind the target at x = 4
+    assert ahead_s == pytest.approx(-2.0) and aim == pytest.approx([4.75, 0.0, -0.3]) and off_m == pytest.approx(0.5)
+    aim, ahead_s, off_m = lead.aim(line, 0.0, np.array([4.0, 1.0, -0.3]))     # 2 m (4 s) ahead of it, off the line
+    assert ahead_s == pytest.approx(4.0) and aim == pytest.approx([4.75, 0.0, -0.3]) and off_m == pytest.approx(1.0)
     # A steep dive (x = 0.25 t, z = -0.3 - 0.5 t): 0.5 m along it, still at the surface, the swimmer
     # is over where the target will be in 2 s, but nearest (in 3-D) to where it is in 0.4 s.
     dive = TrajectoryTarget(np.array([[0.0, 0.0, -0.3], [2.0, 0.0, -4.3]]), np.array([0.0, 8.0]), 1.0, False)
@@ -413,6 +414,37 @@ def test_a_swimmer_ahead_of_its_target_waits_for_it():
     ahead = TrajectoryTarget(np.array([[2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 18.0]), 0.5, False)
     chasing = TargetChooser(ahead, table(), "prone")(0, state, 0.0)
     assert not chasing.glide and chasing.cycles == 1.0 and chasing.thrust_demand == pytest.approx(1.0)
+
+
+def test_a_swimmer_ahead_of_its_target_but_far_off_its_path_swims_back_instead_of_waiting():
+    """Ahead of the target along its path waits only near the path: 2 m off it (a current carried
+    the swimmer across a corner) it swims at full tempo back toward the path."""
+    lead = Lead()
+    assert lead.waits(2.0, 0.5) and not lead.waits(2.0, 2.0) and not lead.waits(0.2, 0.5)
+    path = TrajectoryTarget(np.array([[-2.0, -2.0, 0.0], [20.0, -2.0, 0.0]]), np.array([0.0, 22.0]), 0.5, False)
+    off = TargetChooser(path, table(), "prone")(0, still_state(np.full(16, 1 / 16)), 0.0)    # 2 m off, 2 m ahead
+    assert off.thrust_demand > 0.0 and off.tempo > TempoControl().min_tempo
+
+
+def test_drift_is_the_sideways_motion_over_a_cycle_and_a_steady_turn_has_none():
+    drift = Drift()
+    for k in range(8):          # heading +x at 1 m/s, carried toward -y at 0.3 m/s
+        drift.update(1.5 * k, np.array([1.5 * k, -0.45 * k, -0.3]), 0.0)
+    assert drift.m_s == pytest.approx([0.0, -0.3], abs=0.01)
+    turning = Drift()
+    for k in range(8):          # a steady 2 m circle, heading along the track
+        angle = 0.5 * k
+        turning.update(float(k), np.array([2 * math.sin(angle), 2 - 2 * math.cos(angle), 0.0]), angle)
+    assert np.abs(turning.m_s).max() < 1e-9
+    # Aimed off upstream by what the drift beyond its dead zone carries it while it swims there (3 s),
+    # at most half the way; a drift within the dead zone (a stroke's own turns) changes nothing.
+    aim = drift.aimed_off(np.zeros(3), np.array([3.0, 0.0, -0.3]), 1.0)
+    assert aim == pytest.approx([3.0, 3.0 * (0.3 - Drift.DEADZONE_M_S), -0.3], abs=0.03)
+    drift.m_s = np.array([0.0, -0.8 * Drift.DEADZONE_M_S])
+    assert drift.aimed_off(np.zeros(3), np.array([3.0, 0.0, -0.3]), 1.0) == pytest.approx([3.0, 0.0, -0.3])
+    strong = Drift()
+    strong.m_s = np.array([0.0, -2.0])
+    assert strong.aimed_off(np.zeros(3), np.array([3.0, 0.0, -0.3]), 1.0) == pytest.approx([3.0, 1.5, -0.3])
 
 
 def test_a_gliding_stroke_near_its_target_glides_only_once_ahead_of_it_along_its_path():

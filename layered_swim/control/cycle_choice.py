@@ -83,33 +83,95 @@ class Lead:
     full_bend_rad: float = math.radians(60.0)   # the path's change of direction over bend_s that earns all of it
     search_s: float = 6.0       # how far along the path, either way from the target, to look for the swimmer
     wait_ahead_s: float = 0.5   # ahead of the target by more than this along its path: slow down
+    # ... but only this close to the path: far off it (a current carried the swimmer across a
+    # corner), "ahead" is its nearest point on the path, and waiting there let the water carry it
+    # on (the crawl ended 15-35 m off a square in a 0.3 m/s cross current). There it swims back.
+    wait_within_m: float = 1.0
     # A stroke that glides near its target (``TempoControl.glide_within_m``) glides only when this
     # far ahead of it along its path: gliding as soon as near, the crawl glided while still behind
     # and trailed its target by about the glide distance (figure-eight 0.76 m; this alone 0.66 m).
     glide_ahead_s: float = 0.2
+    # Steer upstream of the aim by the sideways drift the last cycles measured (``Drift``): a
+    # current across the path otherwise holds the swimmer a metre or two downstream of it.
+    aim_off: bool = False
 
-    def place_on_path_s(self, target: Target, time_s: float, position_m: np.ndarray) -> float:
+    def place_on_path_s(self, target: Target, time_s: float, position_m: np.ndarray) -> tuple[float, float]:
         """When the target passes (or passed) nearest the swimmer, within ``search_s`` of now:
-        where along the path the swimmer is, in the target's time. Nearest in 3-D: a swimmer over
-        a diving path, not yet down, is not ahead on it."""
+        where along the path the swimmer is, in the target's time, and how far across from the
+        path it is there (horizontally). Nearest in 3-D: a swimmer over a diving path, not yet
+        down, is not ahead on it; but it is on it, to wait there."""
         times_s = time_s + np.linspace(-self.search_s, self.search_s, 121)
-        gaps_m = [float(np.linalg.norm(target.position(t) - position_m)) for t in times_s]
-        return float(times_s[int(np.argmin(gaps_m))])
+        points = [target.position(t) - position_m for t in times_s]
+        nearest = int(np.argmin([float(np.linalg.norm(p)) for p in points]))
+        return float(times_s[nearest]), math.hypot(points[nearest][0], points[nearest][1])
 
-    def aim(self, target: Target, time_s: float, position_m: np.ndarray) -> tuple[np.ndarray, float]:
-        """The point to steer for and how many seconds the swimmer is ahead of the target along
-        its path (< 0 behind). Behind, it aims ahead of the target; ahead (it cut a corner or a
-        current carried it), it aims ahead of its own place on the path, not back at the target:
-        swimming back to a target that comes toward it only circles it."""
-        place_s = self.place_on_path_s(target, time_s, position_m)
+    def aim(self, target: Target, time_s: float, position_m: np.ndarray) -> tuple[np.ndarray, float, float]:
+        """The point to steer for, how many seconds the swimmer is ahead of the target along its
+        path (< 0 behind) and how far off the path it is. Behind, it aims ahead of the target;
+        ahead (it cut a corner or a current carried it), it aims ahead of its own place on the
+        path, not back at the target: swimming back to a target that comes toward it only circles it."""
+        place_s, off_path_m = self.place_on_path_s(target, time_s, position_m)
         from_s = max(time_s, place_s)
-        return target.position(from_s + self.seconds(target, from_s)), place_s - time_s
+        return target.position(from_s + self.seconds(target, from_s)), place_s - time_s, off_path_m
+
+    def waits(self, ahead_of_target_s: float, off_path_m: float) -> bool:
+        """Whether to wait for the target: well ahead of it along its path, and on the path."""
+        return ahead_of_target_s > self.wait_ahead_s and off_path_m <= self.wait_within_m
 
     def seconds(self, target: Target, time_s: float) -> float:
         now, later = _step_m(target, time_s), _step_m(target, time_s + self.bend_s)
         norms = float(np.linalg.norm(now) * np.linalg.norm(later))
         bend = math.acos(max(-1.0, min(1.0, float(now @ later) / norms))) if norms > 1e-12 else 0.0
         return self.straight_s + (self.bend_s - self.straight_s) * min(1.0, bend / self.full_bend_rad)
+
+
+class Drift:
+    """The water's sideways push, as a swimmer sees it: how fast the centre of mass moved across
+    its heading over each cycle (the chord of the cycle's track against the mean of its start and
+    end headings, which a steady turn leaves at zero), smoothed over cycles. Along the heading a
+    current only changes the pace, which the tempo control answers; across it, it sets the
+    swimmer off the path."""
+
+    SMOOTHING = 0.5       # the newest cycle's share
+    # Steering acts only on the drift beyond this: in still water a stroke's turns and glides
+    # read as up to ~0.1 m/s of it, and aiming off on that cost the breaststroke 0.1-0.4 m on
+    # the figure-eight and the deep dive.
+    DEADZONE_M_S = 0.1
+    STRAIGHT_COS = math.cos(math.radians(45.0))   # a cycle that turned less than this is read
+
+    def __init__(self):
+        self.reset()
+
+    def reset(self) -> None:
+        self.m_s = np.zeros(2)
+        self._last: tuple[float, np.ndarray, np.ndarray] | None = None
+
+    def update(self, time_s: float, position_m: np.ndarray, heading_rad: float) -> np.ndarray:
+        forward = np.array([math.cos(heading_rad), math.sin(heading_rad)])
+        # A cycle that turned hard (on the spot, after a jump) says nothing of the water: kept out.
+        if self._last is not None and time_s > self._last[0] and float(forward @ self._last[2]) > self.STRAIGHT_COS:
+            then_s, then_m, then_forward = self._last
+            velocity = (position_m[:2] - then_m[:2]) / (time_s - then_s)
+            mean = then_forward + forward
+            norm = math.hypot(mean[0], mean[1])
+            along = mean / norm if norm > 1e-6 else forward
+            across = velocity - float(velocity @ along) * along
+            self.m_s = self.m_s + self.SMOOTHING * (across - self.m_s)
+        self._last = (time_s, np.array(position_m, dtype=float), forward)
+        return self.m_s
+
+    def aimed_off(self, position_m: np.ndarray, aim_m: np.ndarray, speed_m_s: float) -> np.ndarray:
+        """``aim_m`` moved upstream by what the drift (less ``DEADZONE_M_S``) carries the swimmer
+        while it swims there at ``speed_m_s``, at most half the way there (a crab angle up to ~27 deg)."""
+        delta = aim_m[:2] - position_m[:2]
+        distance = math.hypot(delta[0], delta[1])
+        size = math.hypot(self.m_s[0], self.m_s[1])
+        drift = self.m_s * (max(0.0, size - self.DEADZONE_M_S) / size) if size > 0.0 else self.m_s
+        shift = drift * distance / max(speed_m_s, 0.3)
+        size = math.hypot(shift[0], shift[1])
+        if size > 0.5 * distance:
+            shift *= 0.5 * distance / size
+        return np.array([aim_m[0] - shift[0], aim_m[1] - shift[1], aim_m[2]])
 
 
 class TargetChooser:
@@ -127,6 +189,7 @@ class TargetChooser:
         self.level_off_beyond_rad, self.level_off_tempo = level_off_beyond_rad, level_off_tempo
         self._levelling = False
         self.last_wanted: dict[str, float] = {}
+        self.drift = Drift()
 
     def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
         position = state.com_m
@@ -134,13 +197,18 @@ class TargetChooser:
         # or a jump).
         foresight = getattr(self.target, "foresight", True)
         if foresight:
-            target, ahead_of_target_s = self.lead.aim(self.target, state.time_s, position)
+            target, ahead_of_target_s, off_path_m = self.lead.aim(self.target, state.time_s, position)
         else:
-            target, ahead_of_target_s = self.target.position(state.time_s), 0.0
+            target, ahead_of_target_s, off_path_m = self.target.position(state.time_s), 0.0, 0.0
         now = attitude_of(state, self.posture)
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); roll
         # averaged over the last cycle (a crawl rolls +-30 deg within it).
         att = Attitude(now.heading_rad, now.pitch_rad, now.roll_rad if mean_roll_rad is None else mean_roll_rad)
+        if cycle == 0:
+            self.drift.reset()
+        self.drift.update(state.time_s, position, att.heading_rad)
+        if self.lead.aim_off and foresight:      # on a known path (a jump's or the mouse's target has none)
+            target = self.drift.aimed_off(position, target, self.table.pace.speed_at(1.0))
         heading_error = bearing_error(position, target, att.heading_rad)
         distance = float(np.linalg.norm(self.target.position(state.time_s) - position))
         # Started standing up (from treading water), it levels off until it lies; climbing steeply
@@ -151,8 +219,9 @@ class TargetChooser:
             att.pitch_rad - climb_rad > self.level_off_beyond_rad)
         # Ahead of the target along its path: wait for it at the slowest tempo (turning at full tempo
         # instead carried the breaststroke further out of the figure-eight), gliding where the stroke
-        # glides to wait (gliding, the breaststroke's depth drifted 0.27 m off a diving target's).
-        waiting = ahead_of_target_s > self.lead.wait_ahead_s
+        # glides to wait (gliding, the breaststroke's depth drifted 0.27 m off a diving target's);
+        # far off the path it swims back instead.
+        waiting = self.lead.waits(ahead_of_target_s, off_path_m)
         drive = 0.0 if waiting else self.tempo_control.drive(distance, heading_error)
         # Levelling off, kick at the level-off tempo even for a target behind: a fast kick lies it down sooner.
         tempo = self.level_off_tempo if self._levelling else self.tempo_control.tempo_for(drive)

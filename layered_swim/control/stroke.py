@@ -111,6 +111,12 @@ class SteeringSpec(Strict):
     # straight), and wait (slowest tempo, or glide) when more than wait_ahead_s ahead of it.
     lead_bend_s: float = Field(3.0, ge=1.5, le=10.0)
     wait_ahead_s: float = Field(0.5, ge=0.0, le=10.0)
+    # ... and only within this of the path (farther off, swim back to it; a stroke that follows
+    # loosely waits from farther).
+    wait_within_m: float = Field(1.0, gt=0.0, le=100.0)
+    # Steer upstream of the aim by the sideways drift measured over the last cycles (a current
+    # across the path); the goal task's swims, which the shipped residuals learnt on, never do.
+    aim_off: bool = False
     glide_moving_joints: list[str] = []
     # The largest weight the per-cycle layer gives a sequence (its offsets times this; the pose stays
     # inside the joints' ranges); `calibrate` measures turns up to it.
