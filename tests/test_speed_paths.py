@@ -1,6 +1,6 @@
 """The physics step's fast paths give numpy's own bits: the compiled single-quaternion rotation
-and cross product, the one-call wrench + stable PD loads, the compiled hand rules and the goal
-line's one-time position."""
+and cross product, the one-call wrench + stable PD loads, the compiled hand rules, the goal
+line's one-time position and the plates' one call with the added mass."""
 import math
 
 import numpy as np
@@ -106,3 +106,27 @@ def test_the_goal_lines_one_time_position_is_the_arrays():
         assert one.tobytes() == bench.goal_position(task, np.array([t_s]))[0].tobytes()
         assert bench.intermediate_goal(task, float(t_s), 0.5).tobytes() == \
             bench.intermediate_goal(task, np.array(t_s), 0.5).tobytes()
+
+
+def test_the_plates_one_call_with_the_added_mass_equals_the_two_summed():
+    from layered_swim.episode import Episode
+    from layered_swim.fluid.added_mass import AddedMass
+    from layered_swim.fluid.thin_plate import _fluid_wrenches
+
+    episode = Episode("front_crawl")
+    try:
+        fluid = episode.sim.fluid
+        twin = AddedMass(episode.body, fluid.medium.rho_kg_m3)
+        for _ in range(30):
+            state = episode.sim.state
+            plates = _fluid_wrenches(state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s,
+                                     fluid._segments, fluid._medium, fluid._coefficients, fluid._segment_current)
+            added_force, added_torque = twin.wrenches(state, fluid.medium.surface_z_m)
+            expected = (plates[0] + added_force, plates[1] + added_torque)
+            episode.step()            # the simulation's own call, fused
+            got = episode.sim.fluid_now
+            assert got.force_n.tobytes() == expected[0].tobytes() and got.torque_nm.tobytes() == expected[1].tobytes()
+        again = fluid.wrenches(episode.sim.state)      # asked twice at one time, the added mass stands
+        assert fluid.wrenches(episode.sim.state).force_n.tobytes() == again.force_n.tobytes()
+    finally:
+        episode.close()

@@ -106,42 +106,47 @@ def own_inertia(body: Body) -> np.ndarray:
 
 
 @njit(cache=True)
-def _added_mass_wrenches(pos, quat, linvel, angvel, prev_linvel, prev_angvel, prev_force, prev_torque, inv_dt,
-                         own, added, semi, surface_z, explicit):
-    """Force and torque (n, 3), world frame, for the next step (see the module's docstring)."""
+def added_mass_step(pos, quat, linvel, angvel, memory, force, torque, inv_dt, own, added, semi, surface_z, explicit):
+    """One step of the scheme (see the module's docstring), in place: ``force`` and ``torque``
+    (n, 3), world frame, hold the last step's on entry and this step's on return; ``memory``
+    (2, n, 3) the last step's velocity and angular velocity on entry, this step's on return.
+    ``inv_dt`` 0: no last step to read (the first of a run), the water applies nothing."""
     n = pos.shape[0]
     frac, _ = _submerged(pos, quat, semi, surface_z, True)
-    force = np.zeros((n, 3))
-    torque = np.zeros((n, 3))
     R = np.empty(9)                  # row-major: body axis c is column c
     acc = np.empty(3)
     prev = np.empty(3)
     out = np.empty(3)
     for i in range(n):
-        if frac[i] <= 0.0:
-            continue
-        quat_to_rows(quat[i], R, True)
-        for part in range(2):        # 0: translation, 1: rotation
+        if inv_dt <= 0.0 or frac[i] <= 0.0:
             for c in range(3):
-                if part == 0:
-                    acc[c] = (linvel[i, c] - prev_linvel[i, c]) * inv_dt
-                    prev[c] = prev_force[i, c]
-                else:
-                    acc[c] = (angvel[i, c] - prev_angvel[i, c]) * inv_dt
-                    prev[c] = prev_torque[i, c]
-            for c in range(3):       # along body axis c: the world vectors' components R^T v
-                a_c = R[c] * acc[0] + R[3 + c] * acc[1] + R[6 + c] * acc[2]
-                p_c = R[c] * prev[0] + R[3 + c] * prev[1] + R[6 + c] * prev[2]
-                m = frac[i] * added[i, 3 * part + c]
-                if explicit:
-                    out[c] = -m * a_c
-                else:
-                    s = own[i, 3 * part + c]
-                    out[c] = m / (s + m) * (p_c - s * a_c)
-            target = force if part == 0 else torque
-            for r in range(3):       # back to the world: R out
-                target[i, r] = R[3 * r] * out[0] + R[3 * r + 1] * out[1] + R[3 * r + 2] * out[2]
-    return force, torque
+                force[i, c] = 0.0
+                torque[i, c] = 0.0
+        else:
+            quat_to_rows(quat[i], R, True)
+            for part in range(2):        # 0: translation, 1: rotation
+                for c in range(3):
+                    if part == 0:
+                        acc[c] = (linvel[i, c] - memory[0, i, c]) * inv_dt
+                        prev[c] = force[i, c]
+                    else:
+                        acc[c] = (angvel[i, c] - memory[1, i, c]) * inv_dt
+                        prev[c] = torque[i, c]
+                for c in range(3):       # along body axis c: the world vectors' components R^T v
+                    a_c = R[c] * acc[0] + R[3 + c] * acc[1] + R[6 + c] * acc[2]
+                    p_c = R[c] * prev[0] + R[3 + c] * prev[1] + R[6 + c] * prev[2]
+                    m = frac[i] * added[i, 3 * part + c]
+                    if explicit:
+                        out[c] = -m * a_c
+                    else:
+                        s = own[i, 3 * part + c]
+                        out[c] = m / (s + m) * (p_c - s * a_c)
+                target = force if part == 0 else torque
+                for r in range(3):       # back to the world: R out
+                    target[i, r] = R[3 * r] * out[0] + R[3 * r + 1] * out[1] + R[3 * r + 2] * out[2]
+        for c in range(3):
+            memory[0, i, c] = linvel[i, c]
+            memory[1, i, c] = angvel[i, c]
 
 
 class AddedMass:
@@ -171,23 +176,26 @@ class AddedMass:
         """Forget the last step (a new episode): the next evaluation applies nothing."""
         self._time_s: float | None = None
         n = len(self.own)
-        self.force_n = np.zeros((n, 3))
+        self.force_n = np.zeros((n, 3))      # written in place each step (read them before the next)
         self.torque_nm = np.zeros((n, 3))
+        self.memory = np.zeros((2, n, 3))    # the last step's velocities
+
+    def inverse_step_s(self, time_s: float) -> float | None:
+        """What ``added_mass_step`` takes as ``inv_dt`` for a step at ``time_s`` (0: the first of a
+        run, or after a jump in the clock), and remembers the time; None: the same time again
+        (the last answer stands)."""
+        last, self._time_s = self._time_s, time_s
+        if last is not None and time_s == last:
+            return None
+        return 1.0 / (time_s - last) if last is not None and 0.0 < time_s - last <= MAX_STEP_S else 0.0
 
     def wrenches(self, state: BodyState, surface_z_m: float) -> tuple[np.ndarray, np.ndarray]:
         """The force and torque (n, 3), world frame, about each centre of mass, for the step from
-        ``state``. Called once per physics step; called again at the same time it answers the same."""
-        t = state.time_s
-        if self._time_s is not None and t == self._time_s:
-            return self.force_n, self.torque_nm
-        if self._time_s is None or not 0.0 < t - self._time_s <= MAX_STEP_S:
-            self.reset()
-        else:
-            self.force_n, self.torque_nm = _added_mass_wrenches(
-                state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s, self._linvel, self._angvel,
-                self.force_n, self.torque_nm, 1.0 / (t - self._time_s), self.own, self.added, self.semi,
-                float(surface_z_m), self.explicit)
-        self._time_s = t
-        self._linvel = np.array(state.linvel_m_s, dtype=np.float64)
-        self._angvel = np.array(state.angvel_rad_s, dtype=np.float64)
+        ``state``. Called once per physics step; called again at the same time it answers the same.
+        (The plates make the same step inside their own compiled call.)"""
+        inv_dt = self.inverse_step_s(state.time_s)
+        if inv_dt is not None:
+            added_mass_step(state.pos_m, state.quat_xyzw, state.linvel_m_s, state.angvel_rad_s, self.memory,
+                            self.force_n, self.torque_nm, inv_dt, self.own, self.added, self.semi, float(surface_z_m),
+                            self.explicit)
         return self.force_n, self.torque_nm
