@@ -146,7 +146,7 @@ class Drift:
         self.m_s = np.zeros(2)
         self._last: tuple[float, np.ndarray, np.ndarray] | None = None
 
-    def update(self, time_s: float, position_m: np.ndarray, heading_rad: float) -> np.ndarray:
+    def update(self, time_s: float, position_m: np.ndarray, heading_rad: float) -> None:
         forward = np.array([math.cos(heading_rad), math.sin(heading_rad)])
         # A cycle that turned hard (on the spot, after a jump) says nothing of the water: kept out.
         if self._last is not None and time_s > self._last[0] and float(forward @ self._last[2]) > self.STRAIGHT_COS:
@@ -158,7 +158,6 @@ class Drift:
             across = velocity - float(velocity @ along) * along
             self.m_s = self.m_s + self.SMOOTHING * (across - self.m_s)
         self._last = (time_s, np.array(position_m, dtype=float), forward)
-        return self.m_s
 
     def aimed_off(self, position_m: np.ndarray, aim_m: np.ndarray, speed_m_s: float) -> np.ndarray:
         """``aim_m`` moved upstream by what the drift (less ``DEADZONE_M_S``) carries the swimmer
@@ -204,10 +203,10 @@ class TargetChooser:
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); roll
         # averaged over the last cycle (a crawl rolls +-30 deg within it).
         att = Attitude(now.heading_rad, now.pitch_rad, now.roll_rad if mean_roll_rad is None else mean_roll_rad)
-        if cycle == 0:
-            self.drift.reset()
-        self.drift.update(state.time_s, position, att.heading_rad)
         if self.lead.aim_off and foresight:      # on a known path (a jump's or the mouse's target has none)
+            if cycle == 0:
+                self.drift.reset()
+            self.drift.update(state.time_s, position, att.heading_rad)
             target = self.drift.aimed_off(position, target, self.table.pace.speed_at(1.0))
         heading_error = bearing_error(position, target, att.heading_rad)
         distance = float(np.linalg.norm(self.target.position(state.time_s) - position))

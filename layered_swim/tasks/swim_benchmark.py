@@ -108,7 +108,7 @@ def goal_tasks(pool: Pool) -> list[GoalTask]:
 def goal_position(task: GoalTask, t_s) -> np.ndarray:
     """SWIM eq. 1, p_t = (1 - t) p_start + t p_tar with t = t_s / duration in [0, 1]: the
     on-schedule point at time t_s, held at the goal after the horizon. Shape (..., 3)."""
-    if isinstance(t_s, float):     # one time (a controller's target, every control step): the same sums in floats
+    if isinstance(t_s, float):     # one time, numpy floats too (a controller's target each control step): float sums
         f = t_s / task.duration_s
         f = 1.0 if f >= 1.0 else (f if f > 0.0 else 0.0)
         return np.array([(1.0 - f) * a + f * b for a, b in zip(task.start_m, task.goal_m)])
@@ -119,8 +119,6 @@ def goal_position(task: GoalTask, t_s) -> np.ndarray:
 def intermediate_goal(task: GoalTask, t_s, dt_s) -> np.ndarray:
     """SWIM eq. 2: the point dt_s ahead on the schedule, "t + dt capped at 1". The paper mixes
     units (t in [0, 1], dt including T_cycle); we read every dt in seconds."""
-    if isinstance(t_s, float) and isinstance(dt_s, float):
-        return goal_position(task, t_s + dt_s)
     return goal_position(task, np.asarray(t_s, dtype=float) + dt_s)
 
 
