@@ -212,26 +212,32 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                 tempo: float, tempo_control: TempoControl | None):
     if weights is None and target is None:
         return StrokeController(stroke, tempo)
+    goal_line = tempo_control is not None
     if weights is None:
         steer = stroke.steering
         if layers.cycle:
-            # A task with its own tempo control (the goal line) keeps the default aim too: the
-            # shipped residual was trained on it.
-            pace, lead = tempo_control, Lead()
-            if tempo_control is None:
+            # A task with its own tempo control (the goal line) keeps the default aim, and steers the
+            # heading only (no pitch, roll or breath): the shipped residuals were trained on that.
+            pace, lead, pitch_roll = tempo_control, Lead(), (0.0, 0.0)
+            if not goal_line:
+                pitch_roll = (steer.pitch_fraction, steer.roll_fraction)
                 pace = TempoControl(min_tempo=steer.min_tempo, glide_within_m=steer.glide_within_m,
                                     glide_cycles=steer.glide_cycles, turn_tempo=steer.turn_tempo,
                                     turn_tempo_until_ahead_s=steer.turn_tempo_until_ahead_s,
                                     wide_turn_rad=math.radians(steer.wide_turn_deg))
                 lead = Lead(bend_s=steer.lead_bend_s, wait_ahead_s=steer.wait_ahead_s,
                             wait_within_m=steer.wait_within_m, aim_off=steer.aim_off)
-            gains = SteeringGains(steer.yaw_fraction, steer.pitch_fraction, steer.roll_fraction,
-                                  over_weight_within_rad=math.radians(steer.over_weight_within_deg))
+            gains = SteeringGains(steer.yaw_fraction, *pitch_roll,
+                                  over_weight_within_rad=math.radians(steer.over_weight_within_deg),
+                                  depth_within_m=steer.depth_within_m,
+                                  attitude_within_rad=math.radians(steer.attitude_within_deg),
+                                  attitude_proportional=steer.attitude_proportional)
             level_off = (math.radians(steer.level_off_beyond_deg)
                          if LEVEL_OFF in stroke.perturbations and lying(stroke.start.posture) else None)
             weights = TargetChooser(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,
                                     lead=lead, level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo)
         else:
             weights = fixed_weights({}, tempo=tempo)
-    lungs = LungControl(body.lung_air_l, body.max_lung_air_l) if stroke.steering.breathe else None
+    lungs = (LungControl(body.lung_air_l, body.max_lung_air_l, breathe_out=stroke.steering.breathe_out)
+             if stroke.steering.breathe and not goal_line else None)
     return LayeredController(stroke, layout, arm_indices(body, layout), weights, layers, target, lungs)

@@ -50,8 +50,10 @@ def test_auto_holds_a_still_target_by_treading_water_and_never_jumps_the_pose():
         controller, state = episode.controller, episode.sim.state
     finally:
         episode.close()
-    assert controller.switches and controller.switches[0].stroke == HOLD and controller.active == HOLD
-    assert np.linalg.norm(state.com_m[:2] - [2.5, 0.0]) < 1.0
+    # Held: one switch, to treading water, which drifts (backwards, 0.19 m/s on its own) but stays
+    # within the distance at which auto would swim again.
+    assert [switch.stroke for switch in controller.switches] == [HOLD] and controller.active == HOLD
+    assert np.linalg.norm(state.com_m[:2] - [2.5, 0.0]) < RULE.hold_leave_m
     steps = np.abs(np.diff(np.array(poses), axis=0)).max(axis=1)
     hz = episode.sim.config.physics_hz
     switch = int(round(controller.switches[0].time_s * hz))
@@ -103,22 +105,16 @@ def test_auto_leaves_a_held_target_the_moment_it_jumps_away():
     assert (left_s - cycle_start_s) * cycles_per_s < 0.95      # mid-cycle
 
 
-def test_after_treading_water_the_breaststroke_levels_off_and_gets_away_sooner():
-    """Standing after a hold, the breaststroke's level-off sequence lays the body down in a few
-    cycles: 8 s after the target jumps 8 m ahead it is nearer than with the pitch correction
-    alone (4.06 against 4.34 m; before the re-authoring of issue 36, 2.8 against 5.7 m: the
-    sequence was written for the stroke before)."""
+def test_after_treading_water_the_breaststroke_lies_down_and_gets_away():
+    """Standing after a hold, the breaststroke's pitch correction lays the body down (it has no
+    level-off sequence now: with the one written for the stroke before issue 36 it got away later,
+    3.2 against 3.0 m): 8 s after the target jumps 8 m ahead it is within 3.5 m of it."""
     jump = StationTarget(np.array([[2.5, 0.0, -0.3], [10.5, 0.0, -0.3]]), np.array([0.0, 9.0]))
-    left_m = {}
-    for level_off in (True, False):
-        episode = Episode("auto", FollowTarget(jump))
-        chooser = episode.controller.controllers[TURN].chooser
-        assert chooser.level_off_beyond_rad is not None      # the shipped breaststroke has one
-        if not level_off:
-            chooser.level_off_beyond_rad = None
-        try:
-            episode.run(17.0)
-            left_m[level_off] = float(np.linalg.norm(episode.sim.state.com_m - [10.5, 0.0, -0.3]))
-        finally:
-            episode.close()
-    assert left_m[True] < 4.5 and left_m[True] < left_m[False] - 0.2
+    episode = Episode("auto", FollowTarget(jump))
+    assert episode.controller.controllers[TURN].chooser.level_off_beyond_rad is None
+    try:
+        episode.run(17.0)
+        left_m = float(np.linalg.norm(episode.sim.state.com_m - [10.5, 0.0, -0.3]))
+    finally:
+        episode.close()
+    assert left_m < 3.5

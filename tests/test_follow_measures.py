@@ -61,7 +61,7 @@ def test_a_jumping_target_is_not_anticipated():
     """One second before the target jumps behind, the swimmer still heads for where it is."""
     target = StationTarget(np.array([[5.0, 0.0, 0.0], [-5.0, 0.0, 0.0]]), np.array([0.0, 1.0]))
     state = still_state(np.full(16, 1 / 16))
-    assert TargetChooser(target, table(), "prone")(0, state, 0.0).thrust_demand == pytest.approx(1.0)
+    assert TargetChooser(target, table(), "prone")(0, state, None).thrust_demand == pytest.approx(1.0)
 
 
 def test_medians_count_a_run_that_never_got_there_as_worst():

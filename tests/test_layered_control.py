@@ -12,7 +12,16 @@ from layered_swim.control.calibration import CalibrationTable, Pace, load_table
 from layered_swim.control.cycle_choice import Drift, Lead, TargetChooser, TempoControl
 from layered_swim.control.layered import CycleChoice, LayeredController, Layers, fixed_weights
 from layered_swim.control.rules import arm_indices, rule_offsets
-from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, wanted_turns
+from layered_swim.control.steering import (
+    Attitude,
+    MeanAttitude,
+    SteeringGains,
+    attitude_errors,
+    attitude_of,
+    glide_pitch,
+    held_offset,
+    wanted_yaw,
+)
 from layered_swim.control.stroke import (
     LEVEL_OFF,
     JointKeys,
@@ -60,21 +69,87 @@ def test_table_inversion():
 
 def test_weights_pick_the_sequence_that_turns_the_right_way():
     t = table()
-    left = t.weights_for({"yaw": math.radians(4.0)}, 1.0)
+    left = t.weights_for(math.radians(4.0), 1.0)
     assert left == {"yaw_left": pytest.approx(0.5)}
-    right = t.weights_for({"yaw": -math.radians(2.0)}, 1.0)
+    right = t.weights_for(-math.radians(2.0), 1.0)
     assert right == {"yaw_right": pytest.approx(0.5)}
 
 
-def test_wanted_turns_from_target_position():
+def attitude_table() -> CalibrationTable:
+    """Pitch sequences holding +10 / -20 deg at full weight; roll sequences the other way round from
+    their names (roll_left lifts the left shoulder by 8 deg)."""
+    t = table()
+    ramp = np.radians([[0.0, 2.5, 5.0, 7.5, 10.0]])
+    t.attitude_rad.update({"pitch_up": ramp, "pitch_down": -2.0 * ramp, "roll_left": 0.8 * ramp,
+                           "roll_right": -0.8 * ramp})
+    return t
+
+
+def test_attitude_weights_invert_the_held_offsets_whichever_way_a_sequence_goes():
+    t = attitude_table()
+    assert t.attitude_range("pitch", 1.0) == pytest.approx((math.radians(-20.0), math.radians(10.0)))
+    assert t.attitude_weights("pitch", math.radians(5.0), 1.0) == {"pitch_up": pytest.approx(0.5)}
+    assert t.attitude_weights("pitch", math.radians(-5.0), 1.0) == {"pitch_down": pytest.approx(0.25)}
+    assert t.attitude_weights("pitch", math.radians(40.0), 1.0) == {"pitch_up": 1.0}      # at most all of it
+    assert t.attitude_weights("pitch", 0.0, 1.0) == {}
+    # Left shoulder up wanted: the sequence that lifts it, whatever it is called.
+    assert t.attitude_weights("roll", math.radians(4.0), 1.0) == {"roll_left": pytest.approx(0.5)}
+    assert t.attitude_weights("roll", math.radians(-4.0), 1.0) == {"roll_right": pytest.approx(0.5)}
+    assert table().attitude_weights("pitch", 0.1, 1.0) == {} and table().attitude_range("roll", 1.0) == (0.0, 0.0)
+
+
+def test_held_offset_integrates_the_error_within_what_the_sequences_hold():
+    assert held_offset(0.1, 0.2, 0.5, -0.3, 0.3) == pytest.approx(0.2)
+    assert held_offset(0.25, 0.4, 0.5, -0.3, 0.3) == 0.3          # no winding up beyond the sequences
+    assert held_offset(-0.25, -0.4, 0.5, -0.3, 0.3) == -0.3
+    # With a band: only the error beyond it counts; within it, the offset eases back toward none.
+    assert held_offset(0.1, 0.3, 0.5, -0.5, 0.5, within_rad=0.2) == pytest.approx(0.15)
+    assert held_offset(0.1, -0.3, 0.5, -0.5, 0.5, within_rad=0.2) == pytest.approx(0.05)
+    assert held_offset(0.1, 0.15, 0.5, -0.5, 0.5, within_rad=0.2) == pytest.approx(0.05)
+    # Against a static plant (the attitude is the stroke's own plus the held offset), the error
+    # shrinks by the fraction each cycle and never changes sign: no oscillation, no steady error.
+    offset, own, wanted, errors = 0.0, 0.15, -0.05, []
+    for _ in range(12):
+        errors.append(wanted - (own + offset))
+        offset = held_offset(offset, errors[-1], 0.5, -0.5, 0.5)
+    assert all(e < 0 for e in errors) and abs(errors[-1]) < 1e-3 * abs(errors[0])
+
+
+def test_wanted_yaw_and_attitude_errors_from_target_position():
     facing_x = Attitude(heading_rad=0.0, pitch_rad=0.0, roll_rad=0.0)
-    turns = wanted_turns(facing_x, np.zeros(3), np.array([0.0, 5.0, 0.0]), "prone")
-    assert turns["yaw"] > 0                      # target on the left: turn left
-    assert wanted_turns(facing_x, np.zeros(3), np.array([0.0, -5.0, 0.0]), "prone")["yaw"] < 0
-    deeper = wanted_turns(facing_x, np.zeros(3), np.array([3.0, 0.0, -3.0]), "prone")
-    assert deeper["pitch"] < 0                   # target below: nose down
-    left_up = Attitude(heading_rad=0.0, pitch_rad=0.0, roll_rad=0.1)
-    assert wanted_turns(left_up, np.zeros(3), np.array([5.0, 0, 0]), "prone")["roll"] > 0   # left up: roll left
+    assert wanted_yaw(facing_x, np.zeros(3), np.array([0.0, 5.0, 0.0])) > 0        # target on the left: turn left
+    assert wanted_yaw(facing_x, np.zeros(3), np.array([0.0, -5.0, 0.0])) < 0
+    level = MeanAttitude(math.radians(8.0), 0.0)
+    flat = attitude_errors(MeanAttitude(math.radians(8.0), 0.0), np.zeros(3), np.array([5.0, 0, 0]), "prone", level)
+    assert flat == pytest.approx({"roll": 0.0, "pitch": 0.0})          # the stroke's own attitude at the target's depth
+    deeper = attitude_errors(level, np.zeros(3), np.array([3.0, 0.0, -3.0]), "prone", level)
+    assert deeper["pitch"] == pytest.approx(-math.radians(30.0))      # below: nose down, at most the glide limit
+    left_up = attitude_errors(MeanAttitude(math.radians(8.0), 0.1), np.zeros(3), np.array([5.0, 0, 0]), "prone", level)
+    assert left_up["roll"] == pytest.approx(-0.1)                     # left up: bring it down
+    assert "pitch" not in attitude_errors(level, np.zeros(3), np.array([3.0, 0.0, -3.0]), "upright", level)
+    # A target's depth within depth_within_m counts as reached; beyond it, only the rest is steered for.
+    surface = SteeringGains(depth_within_m=0.2)
+    assert glide_pitch(np.zeros(3), np.array([2.0, 0.0, -0.15]), surface) == 0.0
+    assert glide_pitch(np.zeros(3), np.array([5.0, 0.0, -2.2]), surface) == pytest.approx(-math.atan2(2.0, 5.0))
+
+
+def test_the_chooser_holds_pitch_toward_the_target_depth_and_keeps_the_offset():
+    """A swimmer 10 deg nose-down (its own pitch is 0) toward a target at its depth: pitch up, the
+    held offset moving by half the error left each cycle; reset at a new first cycle."""
+    chooser = TargetChooser(FixedTarget((5.0, 0.0, 0.0)), attitude_table(), "prone")
+    state = still_state()
+    nose_down = MeanAttitude(math.radians(-10.0), 0.0)
+    assert chooser(0, state, nose_down).weights == {"pitch_up": pytest.approx(0.5)}      # 5 deg of its 10
+    assert chooser(1, state, MeanAttitude(math.radians(-2.0), 0.0)).weights == {"pitch_up": pytest.approx(0.6)}
+    assert chooser(2, state, MeanAttitude(math.radians(6.0), 0.0)).weights == {"pitch_up": pytest.approx(0.3)}
+    assert chooser(0, state, MeanAttitude(math.radians(6.0), 0.0)).weights == {"pitch_down": pytest.approx(0.15)}
+    # With a proportional share the error is also corrected at once: 4 deg low holds 2 + 4 deg.
+    pi = TargetChooser(FixedTarget((5.0, 0.0, 0.0)), attitude_table(), "prone",
+                       gains=SteeringGains(attitude_proportional=1.0))
+    assert pi(0, state, MeanAttitude(math.radians(-4.0), 0.0)).weights == {"pitch_up": pytest.approx(0.6)}
+    assert pi.held_rad["pitch"] == pytest.approx(math.radians(2.0))
+    off = TargetChooser(FixedTarget((5.0, 0.0, 0.0)), attitude_table(), "prone", gains=SteeringGains(0.7, 0.0, 0.0))
+    assert off(0, state, nose_down).weights == {}
 
 
 def test_layers_parse():
@@ -117,7 +192,7 @@ def test_glide_holds_the_pose_but_the_joints_that_keep_moving():
     moving = stroke.glide_moving
     assert moving[LAYOUT.index("knee_l.flexion")] and not moving[LAYOUT.index("shoulder_l.flexion")]
 
-    def glide(cycle, state, mean_roll_rad):
+    def glide(cycle, state, last_cycle):
         return CycleChoice(glide=True)
     controller = LayeredController(stroke, LAYOUT, arm_indices(BODY, LAYOUT), glide,
                                    Layers(cycle=True, palm=False, reach=False))
@@ -163,9 +238,9 @@ def test_turning_toward_a_target_off_the_heading_swims_at_the_turn_tempo():
     assert TempoControl().turning_tempo(0.8, math.radians(90.0), -1.0) == pytest.approx(0.8)
     state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
     left = FixedTarget((0.0, 3.0, 0.0))
-    assert TargetChooser(left, table(), "prone", tempo=turning)(0, state, 0.0).tempo == pytest.approx(1.2)
-    assert TargetChooser(left, table(), "prone")(0, state, 0.0).tempo == pytest.approx(TempoControl().min_tempo)
-    ahead = TargetChooser(FixedTarget((3.0, 0.0, 0.0)), table(), "prone", tempo=turning)(0, state, 0.0)
+    assert TargetChooser(left, table(), "prone", tempo=turning)(0, state, None).tempo == pytest.approx(1.2)
+    assert TargetChooser(left, table(), "prone")(0, state, None).tempo == pytest.approx(TempoControl().min_tempo)
+    ahead = TargetChooser(FixedTarget((3.0, 0.0, 0.0)), table(), "prone", tempo=turning)(0, state, None)
     assert ahead.tempo == pytest.approx(1.0)
 
 
@@ -182,15 +257,18 @@ def test_steering_settings_come_from_the_stroke_file_and_leave_its_calibration_f
     lead = crawl.controller.chooser.lead
     assert (lead.bend_s, lead.wait_ahead_s) == (steering.lead_bend_s, steering.wait_ahead_s) != (
         Lead().bend_s, Lead().wait_ahead_s)
-    # A task with its own tempo control (the goal, on which the shipped residual was trained) keeps
-    # the default aim.
+    # A task with its own tempo control (the goal, on which the shipped residuals were trained) keeps
+    # the default aim and steers the heading only: no pitch, roll or breath.
     goal = Episode("front_crawl", FollowTarget(FixedTarget([5.0, 0.0, -0.3])), tempo_control=GOAL_TEMPO)
     goal.close()
     assert goal.controller.chooser.lead == Lead() and goal.controller.chooser.tempo_control is GOAL_TEMPO
+    assert steering.pitch_fraction > 0 and steering.breathe
+    goal_gains = goal.controller.chooser.gains
+    assert (goal_gains.pitch_fraction, goal_gains.roll_fraction, goal.controller.lungs) == (0.0, 0.0, None)
     breast = Episode("breaststroke", FollowTarget(FixedTarget([5.0, 0.0, -0.3])))
     breast.close()
     assert breast.controller.chooser.tempo_control.wide_turn_rad == pytest.approx(math.radians(180.0))
-    assert breast.controller.lungs is not None and crawl.controller.lungs is None
+    assert breast.controller.lungs is not None and crawl.controller.lungs is not None
     spec = load(StrokeSpec, stroke_path("front_crawl"))
     edited = spec.model_copy(update={"steering": spec.steering.model_copy(update={"yaw_fraction": 0.1})})
     assert build_stroke(edited, LAYOUT, "x").spec_sha256 == crawl.stroke.spec_sha256
@@ -285,34 +363,26 @@ def test_short_follow_gets_closer_to_a_fixed_target():
     assert end < start - 2.5
 
 
-@pytest.mark.parametrize("stroke_name, axes", [
-    ("treading_water", ("yaw", "pitch", "roll")),
-    # Their roll sequences were written for the strokes before the re-authoring (issue 36) and no
-    # longer roll them monotonically (docs/limitations.md): the crawl's roll steering is off; the
-    # breaststroke's roll_left now rolls it right, and its roll steering, left on, still helps it
-    # follow (figure-eight median 0.94 m against 1.16 m without).
-    ("breaststroke", ("yaw", "pitch")), ("front_crawl", ("yaw", "pitch")),
-    # Their pitch and roll sequences do not yet turn them monotonically at every tempo
-    # (docs/limitations.md); their steering corrects the heading only.
-    ("backstroke", ("yaw",)), ("butterfly", ("yaw",))])
-def test_shipped_calibration_is_fresh_and_every_sequence_turns_monotonically(stroke_name, axes):
-    """Yang Fig. 11: more weight, more turn, for every sequence of the axes given, at every tempo,
-    over weights 0-1; beyond 1 (up to ``steering.max_weight``) too, for the axes it steers with."""
+@pytest.mark.parametrize("stroke_name", ["treading_water", "breaststroke", "front_crawl", "backstroke", "butterfly"])
+def test_shipped_calibration_is_fresh_and_every_steering_sequence_acts_monotonically(stroke_name):
+    """Yang Fig. 11: more weight, more turn, for the yaw sequences at every tempo, over weights 0-1
+    and up to ``steering.max_weight``; and for every attitude axis the stroke steers (a fraction
+    above 0), a sequence each way that holds more offset with more weight."""
     stroke = load_stroke(stroke_name, LAYOUT)
     shipped = load_table(stroke)                       # raises if missing or stale
-    assert set(shipped.turn_rad) == set(stroke.perturbations) - {LEVEL_OFF} == set(
-        ("pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right"))     # level-off: uncalibrated
-    assert stroke.steering.pitch_fraction == 0.0 or "pitch" in axes
-    assert stroke.steering.roll_fraction == 0.0 or "roll" in axes or stroke_name == "breaststroke"
+    assert set(shipped.turn_rad) == {"yaw_left", "yaw_right"}
+    assert set(shipped.attitude_rad) == set(stroke.perturbations) - {LEVEL_OFF, "yaw_left", "yaw_right"} == set(
+        ("pitch_up", "pitch_down", "roll_left", "roll_right"))     # level-off: uncalibrated
     assert shipped.weights[-1] == stroke.steering.max_weight
-    fractions = {"yaw": stroke.steering.yaw_fraction, "pitch": stroke.steering.pitch_fraction,
-                 "roll": stroke.steering.roll_fraction}
-    up_to_one = np.array(shipped.weights) <= 1.0
     for name, rows in shipped.turn_rad.items():
-        axis = name.split("_")[0]
-        if axis in axes:
-            checked = rows if fractions[axis] > 0 else rows[:, up_to_one]
-            assert np.all(np.diff(checked, axis=1) > 0), f"{stroke_name} {name}: {np.degrees(rows).round(2)}"
+        assert np.all(np.diff(rows, axis=1) > 0), f"{stroke_name} {name}: {np.degrees(rows).round(2)}"
+    steered = [axis for axis, fraction in (("pitch", stroke.steering.pitch_fraction),
+                                           ("roll", stroke.steering.roll_fraction)) if fraction > 0]
+    for axis in steered:
+        for tempo in shipped.tempos:
+            for sign in (1.0, -1.0):
+                holding = shipped._holding(axis, tempo, sign)
+                assert holding is not None and np.all(np.diff(holding[1]) > 0), f"{stroke_name} {axis} {sign}"
 
 
 def test_palm_rule_adds_forward_displacement():
@@ -352,7 +422,7 @@ def test_rules_only_add_thrust(stroke):
 def test_rules_stay_out_when_no_more_thrust_is_wanted():
     stroke = load_stroke("breaststroke", LAYOUT)
 
-    def enough(cycle, state, mean_roll_rad):
+    def enough(cycle, state, last_cycle):
         return CycleChoice(thrust_demand=0.0)
     controller = LayeredController(stroke, LAYOUT, arm_indices(BODY, LAYOUT), enough, Layers())
     state = still_state()
@@ -405,14 +475,14 @@ def test_lead_aims_from_the_swimmers_own_place_on_the_path_when_it_is_ahead():
 def test_a_swimmer_ahead_of_its_target_waits_for_it():
     state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
     behind = TrajectoryTarget(np.array([[-2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 22.0]), 0.5, False)
-    waiting = TargetChooser(behind, table(), "prone")(0, state, 0.0)
+    waiting = TargetChooser(behind, table(), "prone")(0, state, None)
     assert (not waiting.glide and waiting.thrust_demand == 0.0
             and waiting.tempo == pytest.approx(TempoControl().min_tempo))
     gliding = TargetChooser(behind, table(), "prone", tempo=TempoControl(glide_within_m=0.6, glide_cycles=0.5))(
-        0, state, 0.0)
+        0, state, None)
     assert gliding.glide and gliding.cycles == 0.5      # a stroke that glides to wait (the crawl) glides
     ahead = TrajectoryTarget(np.array([[2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 18.0]), 0.5, False)
-    chasing = TargetChooser(ahead, table(), "prone")(0, state, 0.0)
+    chasing = TargetChooser(ahead, table(), "prone")(0, state, None)
     assert not chasing.glide and chasing.cycles == 1.0 and chasing.thrust_demand == pytest.approx(1.0)
 
 
@@ -422,7 +492,7 @@ def test_a_swimmer_ahead_of_its_target_but_far_off_its_path_swims_back_instead_o
     lead = Lead()
     assert lead.waits(2.0, 0.5) and not lead.waits(2.0, 2.0) and not lead.waits(0.2, 0.5)
     path = TrajectoryTarget(np.array([[-2.0, -2.0, 0.0], [20.0, -2.0, 0.0]]), np.array([0.0, 22.0]), 0.5, False)
-    off = TargetChooser(path, table(), "prone")(0, still_state(np.full(16, 1 / 16)), 0.0)    # 2 m off, 2 m ahead
+    off = TargetChooser(path, table(), "prone")(0, still_state(np.full(16, 1 / 16)), None)   # 2 m off, 2 m ahead
     assert off.thrust_demand > 0.0 and off.tempo > TempoControl().min_tempo
 
 
@@ -454,11 +524,11 @@ def test_a_gliding_stroke_near_its_target_glides_only_once_ahead_of_it_along_its
     state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
     tempo = TempoControl(glide_within_m=0.4)
     leading = TrajectoryTarget(np.array([[0.3, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 39.4]), 0.5, False)
-    assert not TargetChooser(leading, table(), "prone", tempo=tempo)(0, state, 0.0).glide
+    assert not TargetChooser(leading, table(), "prone", tempo=tempo)(0, state, None).glide
     trailing = TrajectoryTarget(np.array([[-0.3, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 40.6]), 0.5, False)
     chooser = TargetChooser(trailing, table(), "prone", tempo=tempo, lead=Lead(wait_ahead_s=10.0))   # near, not waiting
-    assert chooser(0, state, 0.0).glide
-    assert TargetChooser(FixedTarget((0.3, 0.0, 0.0)), table(), "prone", tempo=tempo)(0, state, 0.0).glide
+    assert chooser(0, state, None).glide
+    assert TargetChooser(FixedTarget((0.3, 0.0, 0.0)), table(), "prone", tempo=tempo)(0, state, None).glide
 
 
 def test_weights_above_one_only_for_a_turn_wanted_within_the_strokes_limit():
@@ -468,7 +538,7 @@ def test_weights_above_one_only_for_a_turn_wanted_within_the_strokes_limit():
 
     def yaw_left_weight(bearing_deg):
         target = FixedTarget((5 * math.cos(math.radians(bearing_deg)), 5 * math.sin(math.radians(bearing_deg)), 0.0))
-        return TargetChooser(target, to_1_5, "prone", gains=gains)(0, state, 0.0).weights["yaw_left"]
+        return TargetChooser(target, to_1_5, "prone", gains=gains)(0, state, None).weights["yaw_left"]
     assert yaw_left_weight(50.0) == 1.5 and yaw_left_weight(100.0) == 1.0
 
 
@@ -477,10 +547,10 @@ def test_a_swimmer_keeps_a_moving_targets_pace_when_close_behind_it():
     speed is 0.6 m/s (0.75 in this table: 0.4 m/s at 0.5, 0.8 m/s at 1.0), not at its slowest."""
     state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
     moving = TrajectoryTarget(np.array([[0.1, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 19.9]), 0.6, False)
-    assert TargetChooser(moving, table(), "prone")(0, state, 0.0).tempo == pytest.approx(0.75)
-    unkept = TargetChooser(moving, table(), "prone", tempo=TempoControl(keep_pace=False))(0, state, 0.0)
+    assert TargetChooser(moving, table(), "prone")(0, state, None).tempo == pytest.approx(0.75)
+    unkept = TargetChooser(moving, table(), "prone", tempo=TempoControl(keep_pace=False))(0, state, None)
     assert unkept.tempo == pytest.approx(TempoControl().min_tempo)
-    still = TargetChooser(FixedTarget((0.1, 0.0, 0.0)), table(), "prone")(0, state, 0.0)
+    still = TargetChooser(FixedTarget((0.1, 0.0, 0.0)), table(), "prone")(0, state, None)
     assert still.tempo == pytest.approx(TempoControl().min_tempo)   # a target that stays: no pace to keep
 
 
@@ -503,21 +573,21 @@ def test_a_swimmer_starting_pitched_up_levels_off_instead_of_correcting_pitch():
                          lying_state.segments)
     assert math.degrees(attitude_of(standing, "prone").pitch_rad) == pytest.approx(60.0)
     pitch_table = table()
-    pitch_table.turn_rad["pitch_down"] = pitch_table.turn_rad["yaw_left"]
+    pitch_table.attitude_rad["pitch_down"] = -pitch_table.turn_rad["yaw_left"]
     target = FixedTarget((5.0, 1.0, 0.0))
     chooser = TargetChooser(target, pitch_table, "prone", level_off_beyond_rad=math.radians(35.0))
-    assert "pitch_down" in TargetChooser(target, pitch_table, "prone")(0, standing, 0.0).weights
-    up = chooser(0, standing, 0.0).weights
+    assert "pitch_down" in TargetChooser(target, pitch_table, "prone")(0, standing, None).weights
+    up = chooser(0, standing, None).weights
     assert up[LEVEL_OFF] == 1.0 and not any(name.startswith("pitch_") for name in up) and up["yaw_left"] > 0
-    assert LEVEL_OFF in chooser(1, standing, 0.0).weights          # still standing: still levelling
-    assert LEVEL_OFF not in chooser(2, lying_state, 0.0).weights   # lying: done...
-    assert LEVEL_OFF not in chooser(3, standing, 0.0).weights      # ...and a later pitch-up is not a start
-    assert LEVEL_OFF not in chooser(0, lying_state, 0.0).weights
+    assert LEVEL_OFF in chooser(1, standing, None).weights          # still standing: still levelling
+    assert LEVEL_OFF not in chooser(2, lying_state, None).weights   # lying: done...
+    assert LEVEL_OFF not in chooser(3, standing, None).weights      # ...and a later pitch-up is not a start
+    assert LEVEL_OFF not in chooser(0, lying_state, None).weights
     # Levelling off, it kicks at its level-off tempo even for a target behind (which would slow it).
     behind = TargetChooser(FixedTarget((-5.0, 1.0, 0.0)), pitch_table, "prone", level_off_beyond_rad=math.radians(35.0),
                            level_off_tempo=1.2)
-    assert behind(0, standing, 0.0).tempo == 1.2
-    assert behind(1, lying_state, 0.0).tempo == pytest.approx(TempoControl().min_tempo)
+    assert behind(0, standing, None).tempo == 1.2
+    assert behind(1, lying_state, None).tempo == pytest.approx(TempoControl().min_tempo)
 
 
 def test_a_level_off_sequence_leaves_the_calibration_valid():
@@ -532,7 +602,7 @@ def test_a_level_off_sequence_leaves_the_calibration_valid():
 
 def test_target_chooser_asks_for_thrust_only_when_far_and_ahead():
     state = still_state(np.full(16, 1 / 16))
-    choice = lambda point: TargetChooser(FixedTarget(point), table(), "prone")(0, state, 0.0)  # noqa: E731
+    choice = lambda point: TargetChooser(FixedTarget(point), table(), "prone")(0, state, None)  # noqa: E731
     assert choice((5.0, 0.0, 0.0)).thrust_demand == pytest.approx(1.0)     # far, straight ahead
     assert choice((0.1, 0.0, 0.0)).thrust_demand == pytest.approx(0.0)     # there already
     assert choice((-5.0, 0.0, 0.0)).thrust_demand == pytest.approx(0.0)    # behind: turn first

@@ -23,6 +23,13 @@ def test_the_lungs_breathe_out_to_sink_and_in_to_rise_no_faster_than_a_breath():
     assert LUNGS.next_air_l(3.0, 0.4, 0.4, 0.5) == pytest.approx(3.0)        # at depth: the resting breath
 
 
+def test_a_stroke_that_only_breathes_in_rises_but_never_empties_to_sink():
+    rising_only = LungControl(rest_air_l=3.0, max_air_l=5.5, breathe_out=False)
+    assert rising_only.next_air_l(3.0, 0.5, 0.75, 0.1) == pytest.approx(3.0)   # deeper target: stays at rest
+    assert rising_only.next_air_l(4.0, 0.5, 0.75, 0.1) == pytest.approx(3.7)   # back down to rest, a breath's pace
+    assert rising_only.next_air_l(3.0, 2.0, 0.3, 0.1) == pytest.approx(3.3)    # pushed deep: breathes in
+
+
 def test_a_breath_changes_the_lung_segments_volume_and_so_the_buoyancy():
     body = load_body()
     out = body.breathing(0.0)

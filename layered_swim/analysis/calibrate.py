@@ -2,8 +2,10 @@
 
 For every perturbation sequence of a stroke, simulate the swimmer in still water at a grid of
 weights and tempos (tempo sets the swimming speed): a few basic cycles to settle, then a few
-cycles with the sequence at that weight. The change of the cycle-averaged heading (yaw), body
-pitch or shoulder roll per cycle, minus the unperturbed drift, is the sequence's turn. The
+cycles with the sequence at that weight. A yaw sequence's turn is the change of the
+cycle-averaged heading per cycle, minus the unperturbed drift; a pitch or roll sequence's is the
+offset of the cycle-averaged body pitch or shoulder roll it holds (the water and buoyancy stop
+it turning further within a cycle), minus the unperturbed stroke's change. The
 unperturbed swims, at more tempos, give the stroke's pace: speed, roll, pitch and depth
 (``layered_swim/control/calibration.py`` keeps and reads the table).
 """
@@ -46,7 +48,7 @@ class _CycleAttitude:
             self._unwrapped += wrap_angle(att.heading_rad - self._heading_prev)
         self._heading_prev = att.heading_rad
         cycle = self.controller.cycle
-        self.samples.setdefault(cycle, []).append((self._unwrapped, att.pitch_rad, -att.roll_rad))
+        self.samples.setdefault(cycle, []).append((self._unwrapped, att.pitch_rad, att.roll_rad))
         if cycle >= SETTLE_CYCLES:
             self.positions.append(sim.state.com_m)
 
@@ -72,7 +74,7 @@ def calibration_swim(job: tuple[str, str | None, float, float]) -> tuple:
     change = (after - before) / MEASURE_CYCLES
     track = np.array(attitude.positions)
     speed = float(np.linalg.norm(track[-1, :2] - track[0, :2]) / (len(track) / control_hz))
-    return ((float(change[axis]) if sequence else change.tolist()), speed, float(-after[2]),   # roll: left up > 0
+    return ((float(change[axis]) if sequence else change.tolist()), speed, float(after[2]),
             float(after[1]), float(-track[-1, 2]))
 
 
@@ -103,12 +105,15 @@ def calibrate(stroke: Stroke, tempos=TEMPOS, pace_tempos=PACE_TEMPOS, workers: i
     baseline = {tempo: unperturbed[pace_tempos.index(tempo)][0] for tempo in tempos}   # drift with no perturbation
     pace = Pace(tuple(pace_tempos), *(tuple(r[k] for r in unperturbed) for k in (1, 2, 3, 4)))
     measured = iter(results[len(pace_tempos):])
-    turn_rad = {}
+    turn_rad, attitude_rad = {}, {}
     for seq in sequences:
         axis, sign = SEQUENCE_AXIS[seq]
         k = AXIS_INDEX[axis]
-        rows = []
-        for tempo in tempos:
-            rows.append([0.0] + [sign * (next(measured)[0] - baseline[tempo][k]) for w in weights if w > 0])
-        turn_rad[seq] = np.array(rows)
-    return CalibrationTable(stroke.name, stroke.spec_sha256, tuple(weights), tuple(tempos), pace, turn_rad)
+        # Pitch and roll: the offset it holds (all its cycles' change), in the axis's own sense
+        # (whichever way the sequence goes).
+        scale = sign if axis == "yaw" else MEASURE_CYCLES
+        rows = np.array([[0.0] + [scale * (next(measured)[0] - baseline[tempo][k]) for w in weights if w > 0]
+                         for tempo in tempos])
+        (turn_rad if axis == "yaw" else attitude_rad)[seq] = rows
+    return CalibrationTable(stroke.name, stroke.spec_sha256, tuple(weights), tuple(tempos), pace, turn_rad,
+                            attitude_rad)

@@ -1,14 +1,17 @@
-"""The per-cycle layer's calibration table (Yang 4.3): each perturbation sequence's turn per cycle
-at a grid of weights and tempos, read from ``strokes/calibration/<stroke>.yaml`` and inverted
-to pick the weight that turns the swimmer through the wanted angle; and the stroke's pace, its
-steady speed, roll, pitch and depth over a wider range of tempos. ``layered-swim calibrate``
+"""The per-cycle layer's calibration table (Yang 4.3), read from ``strokes/calibration/<stroke>.yaml``
+at a grid of weights and tempos: each yaw sequence's turn per cycle, inverted to pick the weight
+that turns the swimmer through the wanted angle; each pitch and roll sequence's held attitude
+(a pitch or roll sequence does not keep turning the body cycle after cycle: the water and the
+buoyancy hold it at an offset, reached within a cycle), inverted to pick the weight that holds
+the wanted offset; and the stroke's pace, its steady speed, roll, pitch and depth over a wider
+range of tempos. ``layered-swim calibrate``
 measures it (``layered_swim/analysis/calibrate.py``). A table made from a different version of
 the stroke file is stale: loading it is an error that says how to remake it.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +24,8 @@ from layered_swim.outputs import write_text
 
 SEQUENCE_AXIS = {"yaw_left": ("yaw", 1.0), "yaw_right": ("yaw", -1.0), "pitch_up": ("pitch", 1.0),
                  "pitch_down": ("pitch", -1.0), "roll_left": ("roll", 1.0), "roll_right": ("roll", -1.0)}
+TURN_SEQUENCES = ("yaw_left", "yaw_right")
+ATTITUDE_AXES = ("pitch", "roll")
 
 
 class CalibrationError(ConfigError):
@@ -61,15 +66,20 @@ class CalibrationSpec(Strict):
     tempos: list[between(0.05, 5.0)] = Field(min_length=1)
     pace: PaceSpec
     turn_deg_per_cycle: dict[Sequence, list[list[Degrees]]]
+    attitude_deg: dict[Sequence, list[list[Degrees]]] = {}
 
     @model_validator(mode="after")
     def _shapes(self) -> "CalibrationSpec":
         _increasing(self.weights, "weights")
         _increasing(self.tempos, "tempos")
         n = len(self.tempos)
-        for name, rows in self.turn_deg_per_cycle.items():
-            if len(rows) != n or any(len(row) != len(self.weights) for row in rows):
-                raise ValueError(f"turn_deg_per_cycle.{name} needs {n} rows of {len(self.weights)} numbers")
+        for key, table in (("turn_deg_per_cycle", self.turn_deg_per_cycle), ("attitude_deg", self.attitude_deg)):
+            for name, rows in table.items():
+                if (name in TURN_SEQUENCES) != (key == "turn_deg_per_cycle"):
+                    raise ValueError(f"{key}.{name}: yaw sequences belong in turn_deg_per_cycle, "
+                                     "pitch and roll sequences in attitude_deg")
+                if len(rows) != n or any(len(row) != len(self.weights) for row in rows):
+                    raise ValueError(f"{key}.{name} needs {n} rows of {len(self.weights)} numbers")
         return self
 
 
@@ -88,6 +98,10 @@ class Pace:
         """The unperturbed stroke's mean roll: the level the per-cycle layer steers back to."""
         return float(np.interp(tempo, self.tempos, self.roll_rad))
 
+    def pitch_at(self, tempo: float) -> float:
+        """The unperturbed stroke's mean pitch: what the per-cycle layer counts as level."""
+        return float(np.interp(tempo, self.tempos, self.pitch_rad))
+
     def tempo_for_speed(self, speed_m_s: float) -> float:
         """The tempo that swims ``speed_m_s`` steadily (read off the rising part of the table; the end
         tempos beyond its range)."""
@@ -104,38 +118,76 @@ class CalibrationTable:
     weights: tuple[float, ...]
     tempos: tuple[float, ...]
     pace: Pace
-    turn_rad: dict[str, np.ndarray]            # per sequence (n_tempos, n_weights), in its own direction
+    turn_rad: dict[str, np.ndarray]            # per yaw sequence (n_tempos, n_weights), in its own direction
+    # per pitch or roll sequence (n_tempos, n_weights): the change of the cycle-mean pitch (nose up > 0)
+    # or shoulder roll (left up > 0) it holds, whichever way its name says
+    attitude_rad: dict[str, np.ndarray] = field(default_factory=dict)
 
-    def turn_at(self, sequence: str, tempo: float) -> np.ndarray:
-        rows = self.turn_rad[sequence]
+    def _at(self, rows: np.ndarray, tempo: float) -> np.ndarray:
         if len(self.tempos) == 1:
             return rows[0]
         return np.array([np.interp(tempo, self.tempos, rows[:, k]) for k in range(len(self.weights))])
 
+    def turn_at(self, sequence: str, tempo: float) -> np.ndarray:
+        return self._at(self.turn_rad[sequence], tempo)
+
     def weight_for(self, sequence: str, wanted_rad: float, tempo: float) -> float:
         """Smallest weight whose calibrated turn reaches ``wanted_rad`` (>= 0), capped at the grid's end."""
-        turns = np.maximum.accumulate(self.turn_at(sequence, tempo))   # a dip means saturation
-        if wanted_rad <= turns[0]:
-            return 0.0
-        if wanted_rad >= turns[-1]:
-            return float(self.weights[-1])
-        i = int(np.searchsorted(turns, wanted_rad, side="left"))      # first grid weight that reaches it
-        w0, w1, t0, t1 = self.weights[i - 1], self.weights[i], turns[i - 1], turns[i]
-        return float(w0 + (w1 - w0) * (wanted_rad - t0) / (t1 - t0))
+        return self._inverse(self.turn_at(sequence, tempo), wanted_rad)
 
-    def weights_for(self, wanted: dict[str, float], tempo: float) -> dict[str, float]:
-        """Wanted signed turns per axis -> one weight per sequence (the sequence turning that way)."""
+    def _inverse(self, effects: np.ndarray, wanted: float) -> float:
+        effects = np.maximum.accumulate(effects)   # a dip means saturation
+        if wanted <= effects[0]:
+            return 0.0
+        if wanted >= effects[-1]:
+            return float(self.weights[-1])
+        i = int(np.searchsorted(effects, wanted, side="left"))      # first grid weight that reaches it
+        w0, w1, e0, e1 = self.weights[i - 1], self.weights[i], effects[i - 1], effects[i]
+        return float(w0 + (w1 - w0) * (wanted - e0) / (e1 - e0))
+
+    def weights_for(self, wanted_yaw_rad: float, tempo: float) -> dict[str, float]:
+        """A wanted signed heading turn (+ left) -> the weight of the yaw sequence turning that way."""
         out = {}
-        for sequence, (axis, sign) in SEQUENCE_AXIS.items():
-            amount = sign * wanted.get(axis, 0.0)
+        for sequence in TURN_SEQUENCES:
+            amount = SEQUENCE_AXIS[sequence][1] * wanted_yaw_rad
             if amount > 0 and sequence in self.turn_rad:
                 out[sequence] = self.weight_for(sequence, amount, tempo)
         return out
+
+    def _holding(self, axis: str, tempo: float, sign: float) -> tuple[str, np.ndarray] | None:
+        """The sequence of ``axis`` that holds the largest offset of ``sign``, and its offsets (made
+        positive) at each weight; a sequence that holds its axis the other way than its name says
+        (one authored for another version of the stroke) is used for the way it does."""
+        best = None
+        for sequence, rows in self.attitude_rad.items():
+            if SEQUENCE_AXIS[sequence][0] == axis:
+                effects = sign * self._at(rows, tempo)
+                if effects.max() > 0.0 and (best is None or effects.max() > best[1].max()):
+                    best = (sequence, effects)
+        return best
+
+    def attitude_range(self, axis: str, tempo: float) -> tuple[float, float]:
+        """The lowest and highest offsets of ``axis`` its sequences hold at ``tempo`` (0 where none)."""
+        low, high = self._holding(axis, tempo, -1.0), self._holding(axis, tempo, 1.0)
+        return (-float(low[1].max()) if low else 0.0), (float(high[1].max()) if high else 0.0)
+
+    def attitude_weights(self, axis: str, offset_rad: float, tempo: float) -> dict[str, float]:
+        """The weight of the sequence that holds ``axis`` (pitch or roll) at ``offset_rad`` from the
+        unperturbed stroke's attitude (at most its calibrated largest)."""
+        holding = self._holding(axis, tempo, math.copysign(1.0, offset_rad)) if offset_rad else None
+        if holding is None:
+            return {}
+        weight = self._inverse(holding[1], abs(offset_rad))
+        return {holding[0]: weight} if weight > 0.0 else {}
 
 
 def calibration_path(stroke: Stroke, directory: Path | None = None) -> Path:
     """A stroke's table: ``calibration/<name>.yaml`` beside its stroke file, unless ``directory``."""
     return (directory or Path(stroke.source).parent / "calibration") / f"{stroke.name}.yaml"
+
+
+def _degrees(table: dict[str, np.ndarray]) -> dict[str, list[list[float]]]:
+    return {name: [[round(math.degrees(v), 3) for v in row] for row in rows] for name, rows in table.items()}
 
 
 def save_table(table: CalibrationTable, path: Path) -> Path:
@@ -149,11 +201,13 @@ def save_table(table: CalibrationTable, path: Path) -> Path:
                  "roll_deg": [round(math.degrees(a), 3) for a in table.pace.roll_rad],
                  "pitch_deg": [round(math.degrees(a), 3) for a in table.pace.pitch_rad],
                  "depth_m": [round(d, 3) for d in table.pace.depth_m]},
-        "turn_deg_per_cycle": {name: [[round(math.degrees(v), 3) for v in row] for row in rows]
-                               for name, rows in table.turn_rad.items()},
+        "turn_deg_per_cycle": _degrees(table.turn_rad),
+        "attitude_deg": _degrees(table.attitude_rad),
     }
     header = (f"# Generated by `layered-swim calibrate --stroke {table.stroke}`; do not edit.\n"
-              "# turn_deg_per_cycle[sequence][tempo index][weight index], in the sequence's own direction.\n")
+              "# turn_deg_per_cycle[yaw sequence][tempo index][weight index], in the sequence's own direction;\n"
+              "# attitude_deg[pitch or roll sequence][tempo index][weight index]: the cycle-mean pitch (nose up > 0)\n"
+              "# or shoulder roll (left up > 0) it holds, less the unperturbed stroke's.\n")
     write_text(path, header + yaml.safe_dump(data, sort_keys=False, default_flow_style=None))
     return path
 
@@ -177,4 +231,5 @@ def load_table(stroke: Stroke, directory: Path | None = None) -> CalibrationTabl
         pace=Pace(tuple(spec.pace.tempos), tuple(spec.pace.speed_m_s),
                   tuple(math.radians(a) for a in spec.pace.roll_deg),
                   tuple(math.radians(a) for a in spec.pace.pitch_deg), tuple(spec.pace.depth_m)),
-        turn_rad={name: np.radians(np.array(rows, dtype=float)) for name, rows in spec.turn_deg_per_cycle.items()})
+        turn_rad={name: np.radians(np.array(rows, dtype=float)) for name, rows in spec.turn_deg_per_cycle.items()},
+        attitude_rad={name: np.radians(np.array(rows, dtype=float)) for name, rows in spec.attitude_deg.items()})

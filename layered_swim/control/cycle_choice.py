@@ -2,9 +2,12 @@
 each cycle's weights and tempo (a ``CycleChoice``), with ``TempoControl`` (how hard to swim) and
 ``Lead`` (where to aim on a moving target's path).
 
-At each cycle start: where is the target relative to the swimmer (heading error, depth, and the
-shoulder roll averaged over the last cycle against the stroke's own), how much of that to correct
-this cycle, and which weights the calibration table says produce those turns. The cycle's tempo
+At each cycle start: where is the target relative to the swimmer (heading error and depth), how
+much of the heading error to turn this cycle, and which weight the calibration table says turns
+that much; and for pitch and roll, which the water holds at an offset rather than letting them
+turn on, the offset to hold: last cycle's moved by a share of the error left between the cycle's
+mean attitude and the wanted one (the stroke's own, pitched toward the target's depth), an
+integral control that neither oscillates nor leaves a steady error. The cycle's tempo
 slows the stroke near the target so the swimmer does not overshoot a slow target (but not below
 a moving target's own pace), and the rules are told how much more thrust is wanted.
 """
@@ -17,7 +20,17 @@ import numpy as np
 
 from layered_swim.control.calibration import CalibrationTable
 from layered_swim.control.layered import CycleChoice
-from layered_swim.control.steering import Attitude, SteeringGains, attitude_of, bearing_error, glide_pitch, wanted_turns
+from layered_swim.control.steering import (
+    MeanAttitude,
+    SteeringGains,
+    attitude_errors,
+    attitude_of,
+    bearing_error,
+    beyond,
+    glide_pitch,
+    held_offset,
+    wanted_yaw,
+)
 from layered_swim.control.stroke import LEVEL_OFF
 from layered_swim.control.targets import Target, target_speed_m_s
 from layered_swim.state import BodyState
@@ -187,10 +200,10 @@ class TargetChooser:
         self.gains, self.tempo_control = gains, tempo
         self.level_off_beyond_rad, self.level_off_tempo = level_off_beyond_rad, level_off_tempo
         self._levelling = False
-        self.last_wanted: dict[str, float] = {}
+        self.held_rad = {"pitch": 0.0, "roll": 0.0}     # the attitude offsets the sequences hold
         self.drift = Drift()
 
-    def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
+    def __call__(self, cycle: int, state: BodyState, last_cycle: MeanAttitude | None) -> CycleChoice:
         position = state.com_m
         # Aim ahead along the target's path (and keep its pace) only where it is known (not a mouse
         # or a jump).
@@ -199,10 +212,12 @@ class TargetChooser:
             target, ahead_of_target_s, off_path_m = self.lead.aim(self.target, state.time_s, position)
         else:
             target, ahead_of_target_s, off_path_m = self.target.position(state.time_s), 0.0, 0.0
-        now = attitude_of(state, self.posture)
-        # Heading and pitch as the cycle starts (the same phase every cycle, and current); roll
-        # averaged over the last cycle (a crawl rolls +-30 deg within it).
-        att = Attitude(now.heading_rad, now.pitch_rad, now.roll_rad if mean_roll_rad is None else mean_roll_rad)
+        # Heading and pitch as the cycle starts (the same phase every cycle, and current); pitch and
+        # roll to steer averaged over the last cycle.
+        att = attitude_of(state, self.posture)
+        mean = last_cycle if last_cycle is not None else MeanAttitude(att.pitch_rad, att.roll_rad)
+        if cycle == 0:
+            self.held_rad = {"pitch": 0.0, "roll": 0.0}
         if self.lead.aim_off and foresight:      # on a known path (a jump's or the mouse's target has none)
             if cycle == 0:
                 self.drift.reset()
@@ -229,19 +244,37 @@ class TargetChooser:
             tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(speed_m_s)))
         if not waiting:
             tempo = self.tempo_control.turning_tempo(tempo, heading_error, ahead_of_target_s)
-        self.last_wanted = wanted_turns(att, position, target, self.posture, self.gains,
-                                        self.table.pace.roll_at(tempo))
+        yaw = wanted_yaw(att, position, target, self.gains)
         near = (distance < self.tempo_control.glide_within_m
                 and (not foresight or ahead_of_target_s > self.lead.glide_ahead_s))
         glide = ((near or (waiting and self.tempo_control.glide_within_m > 0))
                  and abs(heading_error) < self.tempo_control.easy_turn_rad)
-        weights = {} if glide else self.table.weights_for(self.last_wanted, tempo)
-        if abs(self.last_wanted["yaw"]) > self.gains.over_weight_within_rad:
+        weights = {} if glide else self.table.weights_for(yaw, tempo)
+        if not glide:       # a glide holds its first pose: no sequence, and the held offsets wait
+            weights.update(self._attitude_weights(mean, position, target, tempo))
+        if abs(yaw) > self.gains.over_weight_within_rad:
             weights = {name: min(1.0, w) for name, w in weights.items()}
         if self._levelling:
-            weights = {name: w for name, w in weights.items() if not name.startswith("pitch_")}
             weights[LEVEL_OFF] = 1.0
         # Near the target, or turning hard, the rules stop seeking more thrust (Yang 4.4: more force
         # only where more is wanted); else they speed the swimmer past a slow target.
         return CycleChoice(weights, tempo, glide, self.tempo_control.glide_cycles if glide else 1.0,
                            thrust_demand=drive)
+
+    def _attitude_weights(self, mean: MeanAttitude, position_m: np.ndarray, target_m: np.ndarray,
+                          tempo: float) -> dict[str, float]:
+        """The pitch and roll sequences' weights: each axis's held offset moved by its fraction of
+        the error, plus the proportional share of it (levelling off, the level-off sequence does
+        the pitching)."""
+        level = MeanAttitude(self.table.pace.pitch_at(tempo), self.table.pace.roll_at(tempo))
+        errors = attitude_errors(mean, position_m, target_m, self.posture, level, self.gains)
+        fractions = {"pitch": self.gains.pitch_fraction, "roll": self.gains.roll_fraction}
+        weights = {}
+        for axis, error in errors.items():
+            if fractions[axis] > 0.0 and not (axis == "pitch" and self._levelling):
+                low, high = self.table.attitude_range(axis, tempo)
+                within = self.gains.attitude_within_rad
+                self.held_rad[axis] = held_offset(self.held_rad[axis], error, fractions[axis], low, high, within)
+                now = self.held_rad[axis] + self.gains.attitude_proportional * beyond(error, within)
+                weights.update(self.table.attitude_weights(axis, min(high, max(low, now)), tempo))
+        return weights

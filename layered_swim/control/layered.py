@@ -18,7 +18,7 @@ import numpy as np
 from layered_swim.config import ConfigError
 from layered_swim.control.lungs import LungControl
 from layered_swim.control.rules import Arms, rule_offsets
-from layered_swim.control.steering import forward_axis, shoulder_roll
+from layered_swim.control.steering import MeanAttitude, body_pitch, forward_axis, shoulder_roll
 from layered_swim.control.stroke import ALL_SEQUENCES, Stroke
 from layered_swim.control.targets import Target
 from layered_swim.geometry import ease, unit_vector
@@ -63,9 +63,9 @@ class CycleChoice:
 
 class CycleChooser(Protocol):
     """The per-cycle layer's decision rule: called at each cycle start with the cycle's number, the
-    body state and the shoulder roll averaged over the last cycle (None before one has ended)."""
+    body state and the pitch and shoulder roll averaged over the last cycle (None before one has ended)."""
 
-    def __call__(self, cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice: ...
+    def __call__(self, cycle: int, state: BodyState, last_cycle: MeanAttitude | None) -> CycleChoice: ...
 
 
 class LayeredController:
@@ -85,9 +85,9 @@ class LayeredController:
         self.choice = CycleChoice()
         self.cycle = -1
         self.cycle_start_s = 0.0
-        self._roll_sum = 0.0
-        self._roll_n = 0
-        self.last_mean_roll_rad: float | None = None
+        self._attitude_sum = np.zeros(2)
+        self._attitude_n = 0
+        self.last_cycle: MeanAttitude | None = None
         # The air the swimmer holds (None: it does not breathe to steer), and when it last changed.
         self.lung_air_l = self.lungs.rest_air_l if self.lungs is not None else None
         self._last_breath_s: float | None = None
@@ -116,12 +116,12 @@ class LayeredController:
         if self.cycle >= 0:
             self.cycle_start_s += self.choice.cycles / self.cycles_per_s
         self.cycle += 1
-        if self._roll_n:
-            self.last_mean_roll_rad = self._roll_sum / self._roll_n
+        if self._attitude_n:
+            self.last_cycle = MeanAttitude(*(float(a) for a in self._attitude_sum / self._attitude_n))
         self._previous_weights = dict(self.choice.weights)   # fully blended in by the cycle's end
-        self._roll_sum, self._roll_n = 0.0, 0
+        self._attitude_sum, self._attitude_n = np.zeros(2), 0
         if state is not None:
-            self.choice = self.chooser(self.cycle, state, self.last_mean_roll_rad)
+            self.choice = self.chooser(self.cycle, state, self.last_cycle)
             if not self.layers.cycle:
                 self.choice = CycleChoice(tempo=self.choice.tempo)
 
@@ -143,7 +143,7 @@ class LayeredController:
                 pose = pose + weight * offset
                 rate = rate + weight * offset_rate
         if state is not None:
-            self._track_roll(state)
+            self._track_attitude(state)
             if self.lungs is not None and self.layers.cycle:      # depth is steered, like the heading
                 self._breathe(time_s, state)
             if self.layers.palm or self.layers.reach:
@@ -191,11 +191,12 @@ class LayeredController:
         self.lung_air_l = self.lungs.next_air_l(self.lung_air_l, -float(state.pos("pelvis")[2]),
                                                 -float(self.target.position(time_s)[2]), dt_s)
 
-    def _track_roll(self, state: BodyState) -> None:
-        """Accumulate the cycle's mean shoulder roll: a crawl rolls +-30 deg within a cycle, so
-        steering reads the cycle average, not a sample."""
-        self._roll_sum += shoulder_roll(state.quat("thorax"))
-        self._roll_n += 1
+    def _track_attitude(self, state: BodyState) -> None:
+        """Accumulate the cycle's mean pitch and shoulder roll: a crawl rolls +-30 deg within a
+        cycle, and a stroke's pitch swings with its phase, so steering reads the cycle average."""
+        self._attitude_sum += (body_pitch(state.quat("pelvis"), self.stroke.start.posture),
+                               shoulder_roll(state.quat("thorax")))
+        self._attitude_n += 1
 
 
 def fixed_weights(weights: dict[str, float], from_cycle: int = 0, tempo: float = 1.0) -> CycleChooser:
@@ -204,6 +205,6 @@ def fixed_weights(weights: dict[str, float], from_cycle: int = 0, tempo: float =
     if unknown:
         raise ValueError(f"unknown perturbation sequences {sorted(unknown)}")
 
-    def chooser(cycle: int, state: BodyState, mean_roll_rad: float | None) -> CycleChoice:
+    def chooser(cycle: int, state: BodyState, last_cycle: MeanAttitude | None) -> CycleChoice:
         return CycleChoice(dict(weights) if cycle >= from_cycle else {}, tempo)
     return chooser

@@ -45,10 +45,18 @@ def shoulder_roll(thorax_quat: np.ndarray) -> float:
     return math.asin(max(-1.0, min(1.0, lateral_z)))
 
 
+def _elevation(forward: np.ndarray) -> float:
+    return math.asin(max(-1.0, min(1.0, float(forward[2]))))
+
+
+def body_pitch(pelvis_quat: np.ndarray, posture: str) -> float:
+    """The forward axis's elevation (+ nose up)."""
+    return _elevation(forward_axis(pelvis_quat, posture))
+
+
 def attitude(pelvis_quat: np.ndarray, thorax_quat: np.ndarray, posture: str) -> Attitude:
     forward = forward_axis(pelvis_quat, posture)
-    return Attitude(math.atan2(forward[1], forward[0]), math.asin(max(-1.0, min(1.0, forward[2]))),
-                    shoulder_roll(thorax_quat))
+    return Attitude(math.atan2(forward[1], forward[0]), _elevation(forward), shoulder_roll(thorax_quat))
 
 
 def attitude_of(state: BodyState, posture: str) -> Attitude:
@@ -58,33 +66,69 @@ def attitude_of(state: BodyState, posture: str) -> Attitude:
 
 @dataclass(frozen=True)
 class SteeringGains:
-    """How much of the error the layer tries to remove in one cycle, and pitch limits."""
+    """How much of the error the layer tries to remove in one cycle, and pitch limits. The heading
+    turns as long as a yaw sequence works; pitch and roll settle at an offset a sequence holds, so
+    their fractions are integral gains: each cycle the held offset moves by that share of the
+    remaining error; ``attitude_proportional`` of the error is added at once on top (a PI control)."""
 
     yaw_fraction: float = 0.7
     pitch_fraction: float = 0.5
     roll_fraction: float = 0.5
     max_glide_pitch_rad: float = math.radians(30.0)
     over_weight_within_rad: float = math.pi    # weights above 1 only for a heading turn wanted within this
+    depth_within_m: float = 0.0                # the target's depth counts as reached within this
+    attitude_within_rad: float = 0.0           # pitch and roll errors within this are left alone
+    attitude_proportional: float = 0.0         # share of the error (beyond that) added at once to the held offset
 
 
-def wanted_turns(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,
-                 posture: str, gains: SteeringGains = SteeringGains(), level_roll_rad: float = 0.0) -> dict[str, float]:
-    """Signed turns wanted this cycle: yaw (+ left), pitch (+ nose up, toward the glide angle to the
-    target's depth), roll (+ toward the left, i.e. left shoulder down) back to ``level_roll_rad``,
-    the stroke's own mean roll when swimming straight."""
+@dataclass(frozen=True)
+class MeanAttitude:
+    """The body pitch and shoulder roll averaged over a stroke cycle (a crawl rolls +-30 deg within one)."""
+
+    pitch_rad: float
+    roll_rad: float
+
+
+def wanted_yaw(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,
+               gains: SteeringGains = SteeringGains()) -> float:
+    """The signed heading turn wanted this cycle (+ left)."""
     delta = np.asarray(target_m, float) - np.asarray(position_m, float)
-    horizontal = math.hypot(delta[0], delta[1])
-    yaw_error = wrap_angle(math.atan2(delta[1], delta[0]) - att.heading_rad) if horizontal > 1e-6 else 0.0
-    turns = {"yaw": gains.yaw_fraction * yaw_error, "pitch": 0.0,
-             "roll": gains.roll_fraction * (att.roll_rad - level_roll_rad)}
+    if math.hypot(delta[0], delta[1]) <= 1e-6:
+        return 0.0
+    return gains.yaw_fraction * wrap_angle(math.atan2(delta[1], delta[0]) - att.heading_rad)
+
+
+def attitude_errors(mean: MeanAttitude, position_m: np.ndarray, target_m: np.ndarray, posture: str,
+                    level: MeanAttitude, gains: SteeringGains = SteeringGains()) -> dict[str, float]:
+    """How far the cycle's mean attitude is from the wanted one (+: more nose up, more left shoulder
+    up is wanted): roll back to ``level`` (the unperturbed stroke's own), and for a lying stroke the
+    pitch of ``level`` plus the glide angle toward the target's depth."""
+    errors = {"roll": level.roll_rad - mean.roll_rad}
     if lying(posture):
-        turns["pitch"] = gains.pitch_fraction * (glide_pitch(position_m, target_m, gains) - att.pitch_rad)
-    return turns
+        errors["pitch"] = level.pitch_rad + glide_pitch(position_m, target_m, gains) - mean.pitch_rad
+    return errors
+
+
+def beyond(error_rad: float, within_rad: float) -> float:
+    """The part of an error beyond +-``within_rad`` (0 inside)."""
+    return math.copysign(max(0.0, abs(error_rad) - within_rad), error_rad)
+
+
+def held_offset(offset_rad: float, error_rad: float, fraction: float, low_rad: float, high_rad: float,
+                within_rad: float = 0.0) -> float:
+    """Next cycle's held attitude offset: this one moved by ``fraction`` of the error beyond
+    ``within_rad``, within what the sequences can hold (an integral that cannot wind up beyond
+    them); an error within ``within_rad`` is the stroke's own attitude, and the offset eases back
+    toward none by the same fraction."""
+    excess = beyond(error_rad, within_rad)
+    step = excess if excess else -offset_rad
+    return min(high_rad, max(low_rad, offset_rad + fraction * step))
 
 
 def glide_pitch(position_m: np.ndarray, target_m: np.ndarray, gains: SteeringGains = SteeringGains()) -> float:
-    """The pitch (+ nose up) a lying swimmer steers toward: the angle to the target's depth,
-    within +-``max_glide_pitch_rad``."""
+    """The pitch (+ nose up) a lying swimmer steers toward: the angle to the target's depth (less
+    ``depth_within_m``), within +-``max_glide_pitch_rad``."""
     delta = np.asarray(target_m, float) - np.asarray(position_m, float)
-    angle = math.atan2(delta[2], math.hypot(delta[0], delta[1]))
+    rise = math.copysign(max(0.0, abs(delta[2]) - gains.depth_within_m), delta[2])
+    angle = math.atan2(rise, math.hypot(delta[0], delta[1]))
     return max(-gains.max_glide_pitch_rad, min(gains.max_glide_pitch_rad, angle))

@@ -100,6 +100,14 @@ class SteeringSpec(Strict):
     yaw_fraction: float = Field(SteeringGains.yaw_fraction, ge=0.0, le=1.0)
     pitch_fraction: float = Field(SteeringGains.pitch_fraction, ge=0.0, le=1.0)
     roll_fraction: float = Field(SteeringGains.roll_fraction, ge=0.0, le=1.0)
+    # Pitching toward the target's depth, count it reached within this (a surface stroke that rides
+    # shallower than a path cannot dive to it, and held its pitch-down sequence on for nothing).
+    depth_within_m: float = Field(SteeringGains.depth_within_m, ge=0.0, le=10.0)
+    # Pitch and roll errors within this are the stroke's own attitude: no correction, and a held
+    # offset eases back to none (the crawl rides a few degrees off its calibrated pitch as it turns).
+    attitude_within_deg: float = Field(0.0, ge=0.0, le=90.0)
+    # Share of a pitch or roll error (beyond that) corrected at once, on top of the held offset.
+    attitude_proportional: float = Field(SteeringGains.attitude_proportional, ge=0.0, le=2.0)
     min_tempo: float = Field(0.5, ge=0.1, le=1.0)
     glide_within_m: float = Field(0.0, ge=0.0, le=10.0)
     glide_cycles: float = Field(1.0, gt=0.0, le=1.0)     # a glide's length in cycles
@@ -131,6 +139,9 @@ class SteeringSpec(Strict):
     level_off_beyond_deg: float = Field(35.0, gt=0.0, le=90.0)
     level_off_tempo: float = Field(1.0, ge=0.1, le=1.5)    # the tempo of those level-off cycles
     breathe: bool = False           # breathe out to sink and in to rise toward the target's depth
+    # ... breathing out below the resting breath too (false: only in, to rise back from a push;
+    # a crawl that emptied its lungs to dive sank legs first, nose up)
+    breathe_out: bool = True
 
 
 class TrimSpec(Strict):
