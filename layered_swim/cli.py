@@ -41,9 +41,11 @@ COMMANDS = {module.__name__.rpartition(".")[2].replace("_", "-"): module
 
 
 class OneLineParser(argparse.ArgumentParser):
-    """argparse with one-line errors, and values like ``-5,0,5`` taken as values, not options."""
+    """argparse with one-line errors, values like ``-5,0,5`` taken as values, not options, and no
+    abbreviated options (``follow --seed 3`` would have run ``--seeds 3``: three swims)."""
 
     def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = re.compile(r"^-\.?\d")
 

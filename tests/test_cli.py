@@ -66,6 +66,11 @@ def test_run_json(tmp_path):
     assert config["medium"]["rho_kg_m3"] > 0 and config["physics_hz"] == 480
 
 
+def test_an_abbreviated_option_is_an_error_not_another_option():
+    """``follow --seed 3`` is not ``--seeds 3`` (three swims where one seed was meant)."""
+    assert_one_line_error(cli("follow", "figure_eight", "--seed", "3"), "--seed")
+
+
 def test_unknown_stroke(tmp_path):
     assert_one_line_error(cli("run", "--stroke", "no_such_stroke", "--out", str(tmp_path)), "no_such_stroke")
 
