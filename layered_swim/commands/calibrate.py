@@ -1,4 +1,4 @@
-"""``layered-swim calibrate``: measure each perturbation sequence's turn per cycle (Yang 4.3)."""
+"""``layered-swim calibrate``: measure each perturbation sequence's turn per cycle or held offset (Yang 4.3)."""
 from __future__ import annotations
 
 import math
@@ -24,9 +24,10 @@ def run(args) -> None:
     stroke = load_stroke(args.stroke, joint_layout(load_body()))
     calibrated = calibrate(stroke, workers=args.workers, progress=progress(args))
     path = save_table(calibrated, calibration_path(stroke))
-    rows = [[name, f"{calibrated.tempos[-1]:g}"] + [f"{math.degrees(v):.1f}" for v in turns[-1]]
-            for name, turns in calibrated.turn_rad.items()]
+    rows = [[name, f"{calibrated.tempos[-1]:g}"] + [f"{math.degrees(v):.1f}" for v in effects[-1]]
+            for name, effects in {**calibrated.turn_rad, **calibrated.attitude_rad}.items()]
     print(table(rows, ["sequence", "tempo"] + [f"w={w:g}" for w in calibrated.weights]))
     pace = calibrated.pace
-    print(f"\nturn in degrees per cycle; speed {min(pace.speed_m_s):.2f}-{max(pace.speed_m_s):.2f} m/s at tempo "
+    print(f"\nyaw: turn in degrees per cycle; pitch, roll: offset held in degrees; speed "
+          f"{min(pace.speed_m_s):.2f}-{max(pace.speed_m_s):.2f} m/s at tempo "
           f"{pace.tempos[0]:g}-{pace.tempos[-1]:g}; wrote {path}")

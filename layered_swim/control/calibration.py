@@ -25,7 +25,6 @@ from layered_swim.outputs import write_text
 SEQUENCE_AXIS = {"yaw_left": ("yaw", 1.0), "yaw_right": ("yaw", -1.0), "pitch_up": ("pitch", 1.0),
                  "pitch_down": ("pitch", -1.0), "roll_left": ("roll", 1.0), "roll_right": ("roll", -1.0)}
 TURN_SEQUENCES = ("yaw_left", "yaw_right")
-ATTITUDE_AXES = ("pitch", "roll")
 
 
 class CalibrationError(ConfigError):

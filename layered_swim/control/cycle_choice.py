@@ -249,9 +249,9 @@ class TargetChooser:
                 and (not foresight or ahead_of_target_s > self.lead.glide_ahead_s))
         glide = ((near or (waiting and self.tempo_control.glide_within_m > 0))
                  and abs(heading_error) < self.tempo_control.easy_turn_rad)
-        weights = {} if glide else self.table.weights_for(yaw, tempo)
-        if not glide:       # a glide holds its first pose: no sequence, and the held offsets wait
-            weights.update(self._attitude_weights(mean, position, target, tempo))
+        weights = {}        # a glide holds its first pose: no sequence, and the held offsets wait
+        if not glide:
+            weights = self.table.weights_for(yaw, tempo) | self._attitude_weights(mean, position, target, tempo)
         if abs(yaw) > self.gains.over_weight_within_rad:
             weights = {name: min(1.0, w) for name, w in weights.items()}
         if self._levelling:

@@ -85,8 +85,7 @@ class LayeredController:
         self.choice = CycleChoice()
         self.cycle = -1
         self.cycle_start_s = 0.0
-        self._attitude_sum = np.zeros(2)
-        self._attitude_n = 0
+        self._pitch_sum, self._roll_sum, self._attitude_n = 0.0, 0.0, 0
         self.last_cycle: MeanAttitude | None = None
         # The air the swimmer holds (None: it does not breathe to steer), and when it last changed.
         self.lung_air_l = self.lungs.rest_air_l if self.lungs is not None else None
@@ -117,9 +116,9 @@ class LayeredController:
             self.cycle_start_s += self.choice.cycles / self.cycles_per_s
         self.cycle += 1
         if self._attitude_n:
-            self.last_cycle = MeanAttitude(*(float(a) for a in self._attitude_sum / self._attitude_n))
+            self.last_cycle = MeanAttitude(self._pitch_sum / self._attitude_n, self._roll_sum / self._attitude_n)
         self._previous_weights = dict(self.choice.weights)   # fully blended in by the cycle's end
-        self._attitude_sum, self._attitude_n = np.zeros(2), 0
+        self._pitch_sum, self._roll_sum, self._attitude_n = 0.0, 0.0, 0
         if state is not None:
             self.choice = self.chooser(self.cycle, state, self.last_cycle)
             if not self.layers.cycle:
@@ -194,8 +193,8 @@ class LayeredController:
     def _track_attitude(self, state: BodyState) -> None:
         """Accumulate the cycle's mean pitch and shoulder roll: a crawl rolls +-30 deg within a
         cycle, and a stroke's pitch swings with its phase, so steering reads the cycle average."""
-        self._attitude_sum += (body_pitch(state.quat("pelvis"), self.stroke.start.posture),
-                               shoulder_roll(state.quat("thorax")))
+        self._pitch_sum += body_pitch(state.quat("pelvis"), self.stroke.start.posture)
+        self._roll_sum += shoulder_roll(state.quat("thorax"))
         self._attitude_n += 1
 
 

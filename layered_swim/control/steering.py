@@ -129,6 +129,5 @@ def glide_pitch(position_m: np.ndarray, target_m: np.ndarray, gains: SteeringGai
     """The pitch (+ nose up) a lying swimmer steers toward: the angle to the target's depth (less
     ``depth_within_m``), within +-``max_glide_pitch_rad``."""
     delta = np.asarray(target_m, float) - np.asarray(position_m, float)
-    rise = math.copysign(max(0.0, abs(delta[2]) - gains.depth_within_m), delta[2])
-    angle = math.atan2(rise, math.hypot(delta[0], delta[1]))
+    angle = math.atan2(beyond(delta[2], gains.depth_within_m), math.hypot(delta[0], delta[1]))
     return max(-gains.max_glide_pitch_rad, min(gains.max_glide_pitch_rad, angle))
