@@ -90,26 +90,33 @@ class Episode:
         first = next(iter(paths))
         self.stroke_spec: StrokeSpec = specs[first]
         self.stroke: Stroke = strokes[first]
-        if stroke == AUTO:
-            if self.task.target is None or weights is not None or not layers.cycle:
-                raise ConfigError("--stroke auto chooses strokes to chase a target: it needs one (follow, goal, "
-                                  "the app) and the per-cycle layer")
-            controller = AutoStrokeController(
-                {name: _controller(s, self.body, layout, self.task.target, layers, None, tempo, tempo_control)
-                 for name, s in strokes.items()}, self.task.target)
-        else:
-            controller = _controller(self.stroke, self.body, layout, self.task.target, layers, weights, tempo,
-                                     tempo_control)
-        if wrap is not None:          # e.g. a learned residual on top (control/residual.py)
-            controller = wrap(controller, layout)
         config = DEFAULT_SIM.at(physics_hz)
         fluid = make_fluid(backend, self.body, medium, config.gravity_m_s2, fluid_settings)
+        try:
+            controller = self._build_controller(stroke, strokes, layout, layers, weights, tempo, tempo_control, fluid)
+        except BaseException:
+            fluid.close()
+            raise
+        if wrap is not None:          # e.g. a learned residual on top (control/residual.py)
+            controller = wrap(controller, layout)
         self.sim = Simulation(self.body, controller, fluid, config, layout, self.stroke.pd_gain_scale)
         try:
             self.reset(seed)
         except BaseException:
             self.close()
             raise
+
+    def _build_controller(self, stroke, strokes, layout, layers, weights, tempo, tempo_control, fluid):
+        if stroke != AUTO:
+            return _controller(self.stroke, self.body, layout, self.task.target, layers, weights, tempo, tempo_control)
+        if self.task.target is None or weights is not None or not layers.cycle:
+            raise ConfigError("--stroke auto chooses strokes to chase a target: it needs one (follow, goal, "
+                              "the app) and the per-cycle layer")
+        # auto weighs what the target asks against the water's own velocity where the swimmer is.
+        return AutoStrokeController(
+            {name: _controller(s, self.body, layout, self.task.target, layers, None, tempo, tempo_control)
+             for name, s in strokes.items()}, self.task.target,
+            water_at=lambda point_m, time_s: fluid.medium.current_at(point_m, time_s)[0])
 
     @property
     def controller(self):

@@ -6,9 +6,17 @@ import numpy as np
 import pytest
 
 from layered_swim.config import ConfigError
-from layered_swim.control.auto import HOLD, SPRINT, TURN, StrokeChoice
-from layered_swim.control.targets import FixedTarget, StationTarget, load_trajectory, target_speed_m_s
+from layered_swim.control.auto import HOLD, SPRINT, TURN, Ability, StrokeChoice, ability_of
+from layered_swim.control.calibration import load_table
+from layered_swim.control.targets import (
+    FixedTarget,
+    StationTarget,
+    load_trajectory,
+    target_speed_m_s,
+    target_velocity_m_s,
+)
 from layered_swim.episode import Episode
+from layered_swim.fluid.medium import Medium
 from layered_swim.tasks import FollowTarget
 
 RULE = StrokeChoice()
@@ -31,6 +39,69 @@ AHEAD, BEHIND = 0.0, math.radians(150.0)
 ])
 def test_the_rule_picks_the_stroke_for_what_the_target_asks(active, distance, speed, error, expected):
     assert RULE.choose(active, distance, speed, error) == expected
+
+
+# Made-up strokes: the breaststroke's full pace 0.8 m/s, so a target asking over 0.68 m/s (0.85 of it)
+# is kept up with, and left below 0.6 (0.75 of it); "tight" turns most per metre but is fast enough
+# (0.85 of its pace) only up to 0.85 m/s, the crawl up to 1.02.
+ABILITIES = {TURN: Ability(0.8, 0.4), "tight": Ability(1.0, 0.5), SPRINT: Ability(1.2, 0.3), "fast": Ability(1.5, 0.1)}
+
+
+@pytest.mark.parametrize("active, asked, expected", [
+    (TURN, 0.6, TURN),           # within what the breaststroke swims comfortably
+    (TURN, 0.7, "tight"),        # beyond it: the tightest turner fast enough
+    (TURN, 0.95, SPRINT),        # too fast for "tight": the crawl
+    (TURN, 1.2, "fast"),
+    (TURN, 2.0, "fast"),         # faster than any: the fastest
+    ("tight", 0.62, "tight"),    # keeps up down to 0.6 m/s...
+    ("tight", 0.55, TURN),
+    (TURN, 0.65, TURN),          # ...which does not start it
+])
+def test_a_target_asking_more_pace_than_the_breaststroke_gets_the_tightest_turner_fast_enough(active, asked, expected):
+    assert RULE.choose(active, 5.0, asked, AHEAD, asked, ABILITIES) == expected
+
+
+def test_hold_and_sprint_come_before_keeping_up():
+    assert RULE.choose(TURN, 0.5, 0.0, AHEAD, 1.0, ABILITIES) == HOLD      # a still target in a current
+    assert RULE.choose(TURN, 13.0, 1.0, AHEAD, 1.0, ABILITIES) == SPRINT
+
+
+def test_a_strokes_ability_is_read_off_its_calibration():
+    episode = Episode("auto", FollowTarget(FixedTarget([2.5, 0.0, -0.3])))
+    try:
+        butterfly = episode.controller.controllers["butterfly"]
+        abilities = episode.controller.abilities
+    finally:
+        episode.close()
+    table = load_table(butterfly.stroke)
+    top = table.pace.speed_at(1.0)
+    turn = min(table.turn_at("yaw_left", 1.0)[-1], table.turn_at("yaw_right", 1.0)[-1])
+    assert ability_of(butterfly) == Ability(top, pytest.approx(turn / (top * butterfly.stroke.period_s)))
+    assert set(abilities) == {TURN, SPRINT, "butterfly", "backstroke"}       # treading water keeps up with nothing
+
+
+def test_a_current_to_fight_is_swum_with_a_faster_stroke_and_logged():
+    """A target 6 m ahead in a 0.8 m/s current against the way to it asks more than the
+    breaststroke's comfortable pace: at its first cycle's end auto takes the stroke the rule picks."""
+    episode = Episode("auto", FollowTarget(FixedTarget([6.0, 0.0, -0.3])), medium=Medium(current_m_s=(-0.8, 0.0, 0.0)))
+    try:
+        expected = episode.controller.choice_rule.keeping_up(0.8, episode.controller.abilities)
+        episode.run(2.0)
+        switches = episode.controller.switches
+    finally:
+        episode.close()
+    assert expected != TURN and [s.stroke for s in switches] == [expected]
+
+
+def test_a_jump_asks_no_pace_but_a_current_does():
+    jump = StationTarget(np.array([[0.0, 0.0, -0.3], [8.0, 0.0, -0.3]]), np.array([0.0, 10.0]))
+    assert np.linalg.norm(target_velocity_m_s(jump, 10.5)) > RULE.jumped_beyond_m_s
+    for current, asked in [((0.0, 0.0, 0.0), 0.0), ((0.3, -0.4, 0.1), 0.5)]:
+        episode = Episode("auto", FollowTarget(jump), medium=Medium(current_m_s=current))
+        try:
+            assert episode.controller._asked_m_s(10.5, np.array([1.0, 2.0, -0.3])) == pytest.approx(asked)
+        finally:
+            episode.close()
 
 
 def test_target_speed_looks_ahead_only_where_the_path_is_known():

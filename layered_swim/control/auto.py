@@ -8,9 +8,14 @@ of every cycle of the stroke swimming now, ``StrokeChoice`` looks at the target:
   water, which stays where it is and turns on the spot; treading goes on until the target is
   ``hold_leave_m`` away or starts moving;
 - **sprint**: a target far ahead (``sprint_beyond_m``, within ``sprint_ahead_rad`` of the
-  heading) is chased with the crawl, the fastest stroke, until it is near or off to the side
-  (only far: from a standstill the crawl's first cycles wobble, and a breaststroke reaches a
-  jump 8-10 m away sooner);
+  heading) is chased with the crawl, until it is near or off to the side (only far: from a
+  standstill the crawl's first cycles wobble, and a breaststroke reaches a jump 8-10 m away sooner);
+- **keep up**: a target that asks more speed through the water than the breaststroke swims
+  comfortably (its speed less the water's, beyond ``keep_up_share`` of the breaststroke's full
+  pace: a fast target, or a current to fight) is followed with the stroke that turns most per
+  metre among those that swim that speed within ``keep_up_share`` of their own full pace, or
+  with the fastest where none does (``Ability``: read off each stroke's calibration, so a stroke
+  tuned again is ranked again); it goes back to the breaststroke below ``keep_up_leave_share``;
 - **otherwise** breaststroke: the tighter turn and the slower pace, for bends and approaches.
 
 Holding starts at once, mid-cycle, when a still target comes within reach (a stroke circling it
@@ -22,19 +27,35 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Callable, NamedTuple
 
 import numpy as np
 
+from layered_swim.control.cycle_choice import TargetChooser
 from layered_swim.control.layered import LayeredController
 from layered_swim.control.steering import attitude_of, bearing_error
-from layered_swim.control.targets import Target, target_speed_m_s
+from layered_swim.control.targets import Target, target_speed_m_s, target_velocity_m_s
 from layered_swim.geometry import ease
 from layered_swim.state import BodyState
 
 AUTO = "auto"
 SPRINT, TURN, HOLD = "front_crawl", "breaststroke", "treading_water"
-AUTO_STROKES = (TURN, SPRINT, HOLD)      # the first is the one it starts with
+AUTO_STROKES = (TURN, SPRINT, HOLD, "butterfly", "backstroke")      # the first is the one it starts with
+
+
+class Ability(NamedTuple):
+    """What a stroke can do, from its calibration: its steady speed at full tempo, and how much its
+    yaw sequences turn it per metre swum at full tempo (the weakest side, at the largest weight)."""
+
+    top_m_s: float
+    turn_rad_per_m: float
+
+
+def ability_of(controller: LayeredController) -> Ability:
+    table = controller.chooser.table
+    top_m_s = table.pace.speed_at(1.0)
+    turn_rad = min(float(np.max(table.turn_at(name, 1.0))) for name in table.turn_rad)
+    return Ability(top_m_s, turn_rad / (top_m_s * controller.stroke.period_s))
 
 
 @dataclass(frozen=True)
@@ -46,6 +67,10 @@ class StrokeChoice:
     sprint_until_m: float = 3.0
     sprint_ahead_rad: float = math.radians(30.0)
     sprint_keep_rad: float = math.radians(60.0)
+    keep_up_share: float = 0.85
+    keep_up_leave_share: float = 0.75
+    # A target that moved faster than any swimmer has jumped (a station, the mouse): it asks no pace.
+    jumped_beyond_m_s: float = 3.0
     blend_s: float = 0.5
 
     def holds(self, active: str, distance_m: float, target_speed_m_s: float) -> bool:
@@ -53,14 +78,31 @@ class StrokeChoice:
         return target_speed_m_s < self.still_m_s and distance_m < (
             self.hold_leave_m if active == HOLD else self.hold_within_m)
 
-    def choose(self, active: str, distance_m: float, target_speed_m_s: float, heading_error_rad: float) -> str:
+    def choose(self, active: str, distance_m: float, target_speed_m_s: float, heading_error_rad: float,
+               asked_m_s: float = 0.0, abilities: dict[str, Ability] | None = None) -> str:
+        """``asked_m_s``: the speed through the water that keeps with the target (its velocity less
+        the water's); ``abilities``: the strokes that may keep up with it (none: only the
+        breaststroke, crawl and treading water are chosen)."""
         if self.holds(active, distance_m, target_speed_m_s):
             return HOLD
         error = abs(heading_error_rad)
         if (distance_m > self.sprint_beyond_m and error < self.sprint_ahead_rad) or (
                 active == SPRINT and distance_m > self.sprint_until_m and error < self.sprint_keep_rad):
             return SPRINT
+        if abilities:
+            keeping = active != TURN and active in abilities
+            share = self.keep_up_leave_share if keeping else self.keep_up_share
+            if asked_m_s > share * abilities[TURN].top_m_s:
+                return self.keeping_up(asked_m_s, abilities)
         return TURN
+
+    def keeping_up(self, asked_m_s: float, abilities: dict[str, Ability]) -> str:
+        """The stroke that turns most per metre among those fast enough for ``asked_m_s``, else the fastest."""
+        others = {name: a for name, a in abilities.items() if name != TURN}
+        fast = [name for name, a in others.items() if asked_m_s <= self.keep_up_share * a.top_m_s]
+        if fast:
+            return max(fast, key=lambda name: others[name].turn_rad_per_m)
+        return max(others, key=lambda name: others[name].top_m_s)
 
 
 class Switch(NamedTuple):
@@ -74,8 +116,17 @@ class AutoStrokeController:
     """Several strokes' layered controllers, one swimming at a time, switched by ``choice``."""
 
     def __init__(self, controllers: dict[str, LayeredController], target: Target,
-                 choice: StrokeChoice = StrokeChoice(), first: str = AUTO_STROKES[0]):
+                 choice: StrokeChoice = StrokeChoice(), first: str = AUTO_STROKES[0],
+                 water_at: Callable[[np.ndarray, float], np.ndarray] | None = None):
+        """``water_at(point_m, time_s)``: the water's own velocity there (the current and flow
+        field, not the body's wake); None: still water."""
         self.controllers, self.target, self.choice_rule, self.first = controllers, target, choice, first
+        self.water_at = water_at
+        # The strokes that may keep up with a fast target: the breaststroke's pace is the bar.
+        self.abilities = {name: ability_of(c) for name, c in controllers.items()
+                          if name != HOLD and isinstance(c.chooser, TargetChooser)}
+        if TURN not in self.abilities:
+            self.abilities = {}
         self.reset()
 
     def reset(self) -> None:
@@ -142,7 +193,18 @@ class AutoStrokeController:
         heading = attitude_of(state, self.current.stroke.start.posture).heading_rad
         return self.choice_rule.choose(self.active, float(np.linalg.norm(goal - position)),
                                        target_speed_m_s(self.target, state.time_s),
-                                       bearing_error(position, goal, heading))
+                                       bearing_error(position, goal, heading),
+                                       self._asked_m_s(state.time_s, position), self.abilities)
+
+    def _asked_m_s(self, time_s: float, position_m: np.ndarray) -> float:
+        """The horizontal speed through the water that keeps with the target: its velocity less the
+        water's at ``position_m``."""
+        velocity = target_velocity_m_s(self.target, time_s)
+        if np.linalg.norm(velocity) > self.choice_rule.jumped_beyond_m_s:
+            velocity = np.zeros(3)
+        if self.water_at is not None:
+            velocity = velocity - self.water_at(position_m, time_s)
+        return float(np.hypot(velocity[0], velocity[1]))
 
     def _hold_changes_now(self, state: BodyState) -> bool:
         """Whether holding should start or end now, mid-cycle: a still target come within reach is

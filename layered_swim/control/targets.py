@@ -141,12 +141,22 @@ class StationTarget:
         return self._points.copy()
 
 
-def target_speed_m_s(target: Target, time_s: float, over_s: float = 1.0) -> float:
-    """How fast the target moves now: over the next ``over_s`` where its path is known ahead, over
-    the last ``over_s`` where it is not (a mouse, a jump)."""
+def _moved_m(target: Target, time_s: float, over_s: float) -> np.ndarray:
+    """How far the target moves over the next ``over_s`` where its path is known ahead, over the
+    last ``over_s`` where it is not (a mouse, a jump)."""
     if getattr(target, "foresight", True):
-        return float(np.linalg.norm(target.position(time_s + over_s) - target.position(time_s))) / over_s
-    return float(np.linalg.norm(target.position(time_s) - target.position(max(0.0, time_s - over_s)))) / over_s
+        return target.position(time_s + over_s) - target.position(time_s)
+    return target.position(time_s) - target.position(max(0.0, time_s - over_s))
+
+
+def target_velocity_m_s(target: Target, time_s: float, over_s: float = 1.0) -> np.ndarray:
+    """How the target moves now (see ``_moved_m``)."""
+    return _moved_m(target, time_s, over_s) / over_s
+
+
+def target_speed_m_s(target: Target, time_s: float, over_s: float = 1.0) -> float:
+    """How fast the target moves now (see ``_moved_m``)."""
+    return float(np.linalg.norm(_moved_m(target, time_s, over_s))) / over_s
 
 
 # ---------------------------------------------------------------- file schemas
