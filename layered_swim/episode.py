@@ -116,7 +116,8 @@ class Episode:
         return AutoStrokeController(
             {name: _controller(s, self.body, layout, self.task.target, layers, None, tempo, tempo_control)
              for name, s in strokes.items()}, self.task.target,
-            water_at=lambda point_m, time_s: fluid.medium.current_at(point_m, time_s)[0])
+            water_at=lambda point_m, time_s: fluid.medium.current_at(point_m, time_s)[0],
+            surface_z_m=lambda: fluid.medium.surface_z_m)
 
     @property
     def controller(self):

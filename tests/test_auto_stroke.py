@@ -61,9 +61,13 @@ def test_a_target_asking_more_pace_than_the_breaststroke_gets_the_tightest_turne
     assert RULE.choose(active, 5.0, asked, AHEAD, asked, ABILITIES) == expected
 
 
-def test_hold_and_sprint_come_before_keeping_up():
+def test_hold_dive_and_sprint_come_before_keeping_up():
     assert RULE.choose(TURN, 0.5, 0.0, AHEAD, 1.0, ABILITIES) == HOLD      # a still target in a current
     assert RULE.choose(TURN, 13.0, 1.0, AHEAD, 1.0, ABILITIES) == SPRINT
+    # A deep target, however fast or far: the breaststroke, which holds a depth.
+    for distance in (5.0, 13.0):
+        assert RULE.choose("tight", distance, 1.0, AHEAD, 1.0, ABILITIES, depth_m=1.5) == TURN
+    assert RULE.choose(TURN, 5.0, 1.0, AHEAD, 1.0, ABILITIES, depth_m=0.5) == SPRINT
 
 
 def test_a_strokes_ability_is_read_off_its_calibration():
@@ -80,17 +84,21 @@ def test_a_strokes_ability_is_read_off_its_calibration():
     assert set(abilities) == {TURN, SPRINT, "butterfly", "backstroke"}       # treading water keeps up with nothing
 
 
-def test_a_current_to_fight_is_swum_with_a_faster_stroke_and_logged():
+@pytest.mark.parametrize("depth_m", [0.3, 1.5])
+def test_a_current_to_fight_is_swum_with_a_faster_stroke_and_logged(depth_m):
     """A target 6 m ahead in a 0.8 m/s current against the way to it asks more than the
-    breaststroke's comfortable pace: at its first cycle's end auto takes the stroke the rule picks."""
-    episode = Episode("auto", FollowTarget(FixedTarget([6.0, 0.0, -0.3])), medium=Medium(current_m_s=(-0.8, 0.0, 0.0)))
+    breaststroke's comfortable pace: at its first cycle's end auto takes the stroke the rule picks,
+    unless the target is deep (the breaststroke holds a depth)."""
+    episode = Episode("auto", FollowTarget(FixedTarget([6.0, 0.0, -depth_m])),
+                      medium=Medium(current_m_s=(-0.8, 0.0, 0.0)))
     try:
         expected = episode.controller.choice_rule.keeping_up(0.8, episode.controller.abilities)
         episode.run(2.0)
         switches = episode.controller.switches
     finally:
         episode.close()
-    assert expected != TURN and [s.stroke for s in switches] == [expected]
+    assert expected != TURN
+    assert [s.stroke for s in switches] == ([expected] if depth_m < RULE.dive_beyond_m else [])
 
 
 def test_a_jump_asks_no_pace_but_a_current_does():

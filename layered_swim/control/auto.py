@@ -7,6 +7,8 @@ of every cycle of the stroke swimming now, ``StrokeChoice`` looks at the target:
 - **hold**: a target that stays put (or creeps) within ``hold_within_m`` is held by treading
   water, which stays where it is and turns on the spot; treading goes on until the target is
   ``hold_leave_m`` away or starts moving;
+- **dive**: a target deeper than ``dive_beyond_m`` is followed with the breaststroke, the one
+  stroke that holds a depth (the others ride the surface);
 - **sprint**: a target far ahead (``sprint_beyond_m``, within ``sprint_ahead_rad`` of the
   heading) is chased with the crawl, until it is near or off to the side (only far: from a
   standstill the crawl's first cycles wobble, and a breaststroke reaches a jump 8-10 m away sooner);
@@ -45,7 +47,7 @@ AUTO_STROKES = (TURN, SPRINT, HOLD, "butterfly", "backstroke")      # the first 
 
 class Ability(NamedTuple):
     """What a stroke can do, from its calibration: its steady speed at full tempo, and how much its
-    yaw sequences turn it per metre swum at full tempo (the weakest side, at the largest weight)."""
+    yaw sequences turn it per metre swum at full tempo (the weaker side, at its strongest weight)."""
 
     top_m_s: float
     turn_rad_per_m: float
@@ -71,6 +73,7 @@ class StrokeChoice:
     keep_up_leave_share: float = 0.75
     # A target that moved faster than any swimmer has jumped (a station, the mouse): it asks no pace.
     jumped_beyond_m_s: float = 3.0
+    dive_beyond_m: float = 1.0
     blend_s: float = 0.5
 
     def holds(self, active: str, distance_m: float, target_speed_m_s: float) -> bool:
@@ -79,12 +82,14 @@ class StrokeChoice:
             self.hold_leave_m if active == HOLD else self.hold_within_m)
 
     def choose(self, active: str, distance_m: float, target_speed_m_s: float, heading_error_rad: float,
-               asked_m_s: float = 0.0, abilities: dict[str, Ability] | None = None) -> str:
+               asked_m_s: float = 0.0, abilities: dict[str, Ability] | None = None, depth_m: float = 0.0) -> str:
         """``asked_m_s``: the speed through the water that keeps with the target (its velocity less
         the water's); ``abilities``: the strokes that may keep up with it (none: only the
-        breaststroke, crawl and treading water are chosen)."""
+        breaststroke, crawl and treading water are chosen); ``depth_m``: the target's depth."""
         if self.holds(active, distance_m, target_speed_m_s):
             return HOLD
+        if depth_m > self.dive_beyond_m:
+            return TURN
         error = abs(heading_error_rad)
         if (distance_m > self.sprint_beyond_m and error < self.sprint_ahead_rad) or (
                 active == SPRINT and distance_m > self.sprint_until_m and error < self.sprint_keep_rad):
@@ -117,11 +122,12 @@ class AutoStrokeController:
 
     def __init__(self, controllers: dict[str, LayeredController], target: Target,
                  choice: StrokeChoice = StrokeChoice(), first: str = AUTO_STROKES[0],
-                 water_at: Callable[[np.ndarray, float], np.ndarray] | None = None):
+                 water_at: Callable[[np.ndarray, float], np.ndarray] | None = None,
+                 surface_z_m: Callable[[], float] = lambda: 0.0):
         """``water_at(point_m, time_s)``: the water's own velocity there (the current and flow
-        field, not the body's wake); None: still water."""
+        field, not the body's wake); None: still water. ``surface_z_m()``: where the surface is."""
         self.controllers, self.target, self.choice_rule, self.first = controllers, target, choice, first
-        self.water_at = water_at
+        self.water_at, self.surface_z_m = water_at, surface_z_m
         # The strokes that may keep up with a fast target: the breaststroke's pace is the bar.
         self.abilities = {name: ability_of(c) for name, c in controllers.items()
                           if name != HOLD and isinstance(c.chooser, TargetChooser)}
@@ -194,7 +200,8 @@ class AutoStrokeController:
         return self.choice_rule.choose(self.active, float(np.linalg.norm(goal - position)),
                                        target_speed_m_s(self.target, state.time_s),
                                        bearing_error(position, goal, heading),
-                                       self._asked_m_s(state.time_s, position), self.abilities)
+                                       self._asked_m_s(state.time_s, position), self.abilities,
+                                       self.surface_z_m() - float(goal[2]))
 
     def _asked_m_s(self, time_s: float, position_m: np.ndarray) -> float:
         """The horizontal speed through the water that keeps with the target: its velocity less the
