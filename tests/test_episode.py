@@ -82,6 +82,21 @@ def test_scripted_weights_with_the_rules_on_swim_straight_ahead():
         episode.close()
 
 
+@pytest.mark.parametrize("rho_kg_m3, min_tempo, kicks", [(997.05, 0.8, True), (1023.3, 0.8, True), (900.0, 0.8, True),
+                                                      (1100.0, 0.5, False), (1500.0, 0.5, False)])
+def test_the_crawl_slows_down_and_glides_still_in_dense_water(rho_kg_m3, min_tempo, kicks):
+    from layered_swim.control.targets import FixedTarget
+    from layered_swim.fluid.medium import water
+    from layered_swim.tasks import FollowTarget
+
+    episode = Episode("front_crawl", FollowTarget(FixedTarget([5.0, 0.0, -0.3])), medium=water(density_kg_m3=rho_kg_m3))
+    try:
+        assert episode.controller.chooser.tempo_control.min_tempo == pytest.approx(min_tempo)
+        assert episode.controller.stroke.glide_moving.any() == kicks
+    finally:
+        episode.close()
+
+
 @pytest.mark.parametrize("rho_kg_m3, hip_deg", [(997.05, 0.0), (1023.3, 0.0), (900.0, 20.0), (2500.0, 20.0)])
 def test_the_breaststroke_is_trimmed_only_in_water_far_from_the_body_density(rho_kg_m3, hip_deg):
     from layered_swim.fluid.medium import water

@@ -116,6 +116,22 @@ def test_trim_weight_is_nothing_near_the_body_density_and_all_far_from_it(tmp_pa
     assert trim.weight(2.25) == pytest.approx(0.25 ** 2 * (3 - 0.5))
 
 
+def test_dense_water_eases_the_slowest_tempo_and_stills_the_glides(tmp_path):
+    text = GOOD + textwrap.dedent("""\
+        steering: {min_tempo: 0.8, glide_within_m: 0.5, glide_moving_joints: [hip_l]}
+        trim: {dense_from: 2.0, dense_full: 3.0, dense_min_tempo: 0.6, dense_still_glide: true}
+    """)
+    stroke = load_stroke(str(write(tmp_path, text)), LAYOUT)
+    assert stroke.glide_moving.any()
+    for ratio, min_tempo, still in [(0.5, 0.8, False), (1.5, 0.8, False), (2.25, 0.8 - 0.2 * 0.25 ** 2 * 2.5, False),
+                                    (2.5, 0.7, True), (3.0, 0.6, True), (5.0, 0.6, True)]:
+        trimmed = stroke.trimmed(ratio)
+        assert trimmed.steering.min_tempo == pytest.approx(min_tempo), ratio
+        assert (not trimmed.glide_moving.any()) == still, ratio
+        assert trimmed.steering.glide_within_m == 0.5
+    assert stroke.steering.min_tempo == 0.8 and stroke.glide_moving.any()     # the stroke itself unchanged
+
+
 def test_a_trimmed_stroke_moves_its_key_poses_by_the_trim(tmp_path):
     stroke = load_stroke(str(write(tmp_path, TRIMMED)), LAYOUT)
     assert stroke.trimmed(1.2) is stroke

@@ -147,13 +147,19 @@ class SteeringSpec(Strict):
 class TrimSpec(Strict):
     """A posture for water far from the body's own density (``density_ratio``: the water's over the
     body's at its resting breath), added to every key pose: nothing in water near the body's
-    density, all of ``joints`` at or beyond ``light_full`` / ``dense_full``, eased in between."""
+    density, all of ``joints`` at or beyond ``light_full`` / ``dense_full``, eased in between.
+    In dense water the slowest tempo may ease toward ``dense_min_tempo`` too, and glides may hold
+    every joint (``dense_still_glide``, from half the trim on): a body that rides high and level
+    there swims on at tempos, and kicks on through glides, that leave it sinking nose-up in fresh
+    water, so without these it cannot slow down for a slow target."""
 
     joints: dict[str, dict[str, Degrees]] = {}
     light_from: float = Field(0.97, gt=0.0, le=1.0)
     light_full: float = Field(0.93, gt=0.0, le=1.0)
     dense_from: float = Field(1.6, ge=1.0, le=10.0)
     dense_full: float = Field(2.4, ge=1.0, le=10.0)
+    dense_min_tempo: float | None = Field(None, ge=0.1, le=1.0)
+    dense_still_glide: bool = False
 
     @model_validator(mode="after")
     def _ordered(self):
@@ -221,11 +227,21 @@ class Stroke:
 
     def trimmed(self, density_ratio: float) -> "Stroke":
         """This stroke for water ``density_ratio`` times the body's density: its key poses moved by
-        the share of the trim that water asks for (none near the body's own density)."""
-        weight = self.trim_spec.weight(density_ratio)
+        the share of the trim that water asks for (none near the body's own density), and in dense
+        water its slowest tempo and glides as the trim says."""
+        trim = self.trim_spec
+        weight = trim.weight(density_ratio)
         if weight == 0.0:
             return self
-        return replace(self, basic=CyclicTable(self.basic.values + weight * self.trim_rad, self.basic.rates))
+        steering, glide_moving = self.steering, self.glide_moving
+        if density_ratio > 1.0:
+            if trim.dense_min_tempo is not None:
+                min_tempo = steering.min_tempo + weight * (trim.dense_min_tempo - steering.min_tempo)
+                steering = steering.model_copy(update={"min_tempo": min_tempo})
+            if trim.dense_still_glide and weight >= 0.5:
+                glide_moving = np.zeros_like(glide_moving)
+        return replace(self, basic=CyclicTable(self.basic.values + weight * self.trim_rad, self.basic.rates),
+                       steering=steering, glide_moving=glide_moving)
 
     @property
     def table(self) -> np.ndarray:
