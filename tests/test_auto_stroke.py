@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from layered_swim.config import ConfigError
-from layered_swim.control.auto import HOLD, SPRINT, TURN, Ability, StrokeChoice, ability_of
+from layered_swim.control.auto import HOLD, SPRINT, TURN, Ability, Ask, StrokeChoice, ability_of
 from layered_swim.control.calibration import load_table
 from layered_swim.control.targets import (
     FixedTarget,
@@ -38,7 +38,7 @@ AHEAD, BEHIND = 0.0, math.radians(150.0)
     (SPRINT, 8.0, 0.5, math.radians(70.0), TURN),
 ])
 def test_the_rule_picks_the_stroke_for_what_the_target_asks(active, distance, speed, error, expected):
-    assert RULE.choose(active, distance, speed, error) == expected
+    assert RULE.choose(active, Ask(distance, speed, error)) == expected
 
 
 # Made-up strokes: the breaststroke's full pace 0.8 m/s, so a target asking over 0.68 m/s (0.85 of it)
@@ -58,16 +58,16 @@ ABILITIES = {TURN: Ability(0.8, 0.4), "tight": Ability(1.0, 0.5), SPRINT: Abilit
     (TURN, 0.65, TURN),          # ...which does not start it
 ])
 def test_a_target_asking_more_pace_than_the_breaststroke_gets_the_tightest_turner_fast_enough(active, asked, expected):
-    assert RULE.choose(active, 5.0, asked, AHEAD, asked, ABILITIES) == expected
+    assert RULE.choose(active, Ask(5.0, asked, AHEAD, asked), ABILITIES) == expected
 
 
 def test_hold_dive_and_sprint_come_before_keeping_up():
-    assert RULE.choose(TURN, 0.5, 0.0, AHEAD, 1.0, ABILITIES) == HOLD      # a still target in a current
-    assert RULE.choose(TURN, 13.0, 1.0, AHEAD, 1.0, ABILITIES) == SPRINT
+    assert RULE.choose(TURN, Ask(0.5, 0.0, AHEAD, 1.0), ABILITIES) == HOLD      # a still target in a current
+    assert RULE.choose(TURN, Ask(13.0, 1.0, AHEAD, 1.0), ABILITIES) == SPRINT
     # A deep target, however fast or far: the breaststroke, which holds a depth.
     for distance in (5.0, 13.0):
-        assert RULE.choose("tight", distance, 1.0, AHEAD, 1.0, ABILITIES, depth_m=1.5) == TURN
-    assert RULE.choose(TURN, 5.0, 1.0, AHEAD, 1.0, ABILITIES, depth_m=0.5) == SPRINT
+        assert RULE.choose("tight", Ask(distance, 1.0, AHEAD, 1.0, depth_m=1.5), ABILITIES) == TURN
+    assert RULE.choose(TURN, Ask(5.0, 1.0, AHEAD, 1.0, depth_m=0.5), ABILITIES) == SPRINT
 
 
 def test_a_strokes_ability_is_read_off_its_calibration():

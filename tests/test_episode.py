@@ -97,7 +97,8 @@ def test_the_crawl_slows_down_and_glides_still_in_dense_water(rho_kg_m3, min_tem
         episode.close()
 
 
-@pytest.mark.parametrize("rho_kg_m3, hip_deg", [(997.05, 0.0), (1023.3, 0.0), (900.0, 20.0), (2500.0, 20.0)])
+@pytest.mark.parametrize("rho_kg_m3, hip_deg", [(997.05, 0.0), (1023.3, 0.0), (900.0, 30.0), (1300.0, 30.0),
+                                               (2500.0, 30.0)])
 def test_the_breaststroke_is_trimmed_only_in_water_far_from_the_body_density(rho_kg_m3, hip_deg):
     from layered_swim.fluid.medium import water
 

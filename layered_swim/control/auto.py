@@ -60,6 +60,16 @@ def ability_of(controller: LayeredController) -> Ability:
     return Ability(top_m_s, turn_rad / (top_m_s * controller.stroke.period_s))
 
 
+class Ask(NamedTuple):
+    """What the target asks of the swimmer now."""
+
+    distance_m: float
+    target_speed_m_s: float
+    heading_error_rad: float
+    pace_m_s: float = 0.0      # the speed through the water that keeps with it (its velocity less the water's)
+    depth_m: float = 0.0
+
+
 @dataclass(frozen=True)
 class StrokeChoice:
     hold_within_m: float = 1.0
@@ -81,24 +91,22 @@ class StrokeChoice:
         return target_speed_m_s < self.still_m_s and distance_m < (
             self.hold_leave_m if active == HOLD else self.hold_within_m)
 
-    def choose(self, active: str, distance_m: float, target_speed_m_s: float, heading_error_rad: float,
-               asked_m_s: float = 0.0, abilities: dict[str, Ability] | None = None, depth_m: float = 0.0) -> str:
-        """``asked_m_s``: the speed through the water that keeps with the target (its velocity less
-        the water's); ``abilities``: the strokes that may keep up with it (none: only the
-        breaststroke, crawl and treading water are chosen); ``depth_m``: the target's depth."""
-        if self.holds(active, distance_m, target_speed_m_s):
+    def choose(self, active: str, ask: Ask, abilities: dict[str, Ability] | None = None) -> str:
+        """``abilities``: the strokes that may keep up with a fast target (none: only the
+        breaststroke, crawl and treading water are chosen)."""
+        if self.holds(active, ask.distance_m, ask.target_speed_m_s):
             return HOLD
-        if depth_m > self.dive_beyond_m:
+        if ask.depth_m > self.dive_beyond_m:
             return TURN
-        error = abs(heading_error_rad)
-        if (distance_m > self.sprint_beyond_m and error < self.sprint_ahead_rad) or (
-                active == SPRINT and distance_m > self.sprint_until_m and error < self.sprint_keep_rad):
+        distance, error = ask.distance_m, abs(ask.heading_error_rad)
+        if (distance > self.sprint_beyond_m and error < self.sprint_ahead_rad) or (
+                active == SPRINT and distance > self.sprint_until_m and error < self.sprint_keep_rad):
             return SPRINT
         if abilities:
             keeping = active != TURN and active in abilities
             share = self.keep_up_leave_share if keeping else self.keep_up_share
-            if asked_m_s > share * abilities[TURN].top_m_s:
-                return self.keeping_up(asked_m_s, abilities)
+            if ask.pace_m_s > share * abilities[TURN].top_m_s:
+                return self.keeping_up(ask.pace_m_s, abilities)
         return TURN
 
     def keeping_up(self, asked_m_s: float, abilities: dict[str, Ability]) -> str:
@@ -197,11 +205,10 @@ class AutoStrokeController:
     def _wanted(self, state: BodyState) -> str:
         goal, position = self.target.position(state.time_s), state.com_m
         heading = attitude_of(state, self.current.stroke.start.posture).heading_rad
-        return self.choice_rule.choose(self.active, float(np.linalg.norm(goal - position)),
-                                       target_speed_m_s(self.target, state.time_s),
-                                       bearing_error(position, goal, heading),
-                                       self._asked_m_s(state.time_s, position), self.abilities,
-                                       self.surface_z_m() - float(goal[2]))
+        ask = Ask(float(np.linalg.norm(goal - position)), target_speed_m_s(self.target, state.time_s),
+                  bearing_error(position, goal, heading), self._asked_m_s(state.time_s, position),
+                  self.surface_z_m() - float(goal[2]))
+        return self.choice_rule.choose(self.active, ask, self.abilities)
 
     def _asked_m_s(self, time_s: float, position_m: np.ndarray) -> float:
         """The horizontal speed through the water that keeps with the target: its velocity less the
