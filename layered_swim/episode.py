@@ -94,11 +94,11 @@ class Episode:
         fluid = make_fluid(backend, self.body, medium, config.gravity_m_s2, fluid_settings)
         try:
             controller = self._build_controller(stroke, strokes, layout, layers, weights, tempo, tempo_control, fluid)
+            if wrap is not None:          # e.g. a learned residual on top (control/residual.py)
+                controller = wrap(controller, layout)
         except BaseException:
             fluid.close()
             raise
-        if wrap is not None:          # e.g. a learned residual on top (control/residual.py)
-            controller = wrap(controller, layout)
         self.sim = Simulation(self.body, controller, fluid, config, layout, self.stroke.pd_gain_scale)
         try:
             self.reset(seed)
