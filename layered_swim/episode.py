@@ -112,12 +112,11 @@ class Episode:
         if self.task.target is None or weights is not None or not layers.cycle:
             raise ConfigError("--stroke auto chooses strokes to chase a target: it needs one (follow, goal, "
                               "the app) and the per-cycle layer")
-        # auto weighs what the target asks against the water's own velocity where the swimmer is.
+        # auto weighs what the target asks against the water swum in (the app may change it).
         return AutoStrokeController(
             {name: _controller(s, self.body, layout, self.task.target, layers, None, tempo, tempo_control)
              for name, s in strokes.items()}, self.task.target,
-            water_at=lambda point_m, time_s: fluid.medium.current_at(point_m, time_s)[0],
-            surface_z_m=lambda: fluid.medium.surface_z_m)
+            medium=lambda: fluid.medium)
 
     @property
     def controller(self):

@@ -29,11 +29,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable, NamedTuple
+from typing import Callable, NamedTuple, Protocol
 
 import numpy as np
 
-from layered_swim.control.cycle_choice import TargetChooser
 from layered_swim.control.layered import LayeredController
 from layered_swim.control.steering import attitude_of, bearing_error
 from layered_swim.control.targets import Target, target_speed_m_s, target_velocity_m_s
@@ -118,6 +117,14 @@ class StrokeChoice:
         return max(others, key=lambda name: others[name].top_m_s)
 
 
+class Water(Protocol):
+    """What ``auto`` reads of the water swum in (a ``fluid.medium.Medium``)."""
+
+    surface_z_m: float
+
+    def current_at(self, points_m: np.ndarray, time_s: float) -> np.ndarray: ...
+
+
 class Switch(NamedTuple):
     """One change of stroke: when, and to which."""
 
@@ -128,19 +135,14 @@ class Switch(NamedTuple):
 class AutoStrokeController:
     """Several strokes' layered controllers, one swimming at a time, switched by ``choice``."""
 
-    def __init__(self, controllers: dict[str, LayeredController], target: Target,
-                 choice: StrokeChoice = StrokeChoice(), first: str = AUTO_STROKES[0],
-                 water_at: Callable[[np.ndarray, float], np.ndarray] | None = None,
-                 surface_z_m: Callable[[], float] = lambda: 0.0):
-        """``water_at(point_m, time_s)``: the water's own velocity there (the current and flow
-        field, not the body's wake); None: still water. ``surface_z_m()``: where the surface is."""
+    def __init__(self, controllers: dict[str, LayeredController], target: Target, *,
+                 medium: Callable[[], Water], choice: StrokeChoice = StrokeChoice(), first: str = AUTO_STROKES[0]):
+        """``medium()``: the water swum in now (its current and flow field, not the body's wake,
+        and where its surface is)."""
         self.controllers, self.target, self.choice_rule, self.first = controllers, target, choice, first
-        self.water_at, self.surface_z_m = water_at, surface_z_m
+        self.medium = medium
         # The strokes that may keep up with a fast target: the breaststroke's pace is the bar.
-        self.abilities = {name: ability_of(c) for name, c in controllers.items()
-                          if name != HOLD and isinstance(c.chooser, TargetChooser)}
-        if TURN not in self.abilities:
-            self.abilities = {}
+        self.abilities = {name: ability_of(c) for name, c in controllers.items() if name != HOLD}
         self.reset()
 
     def reset(self) -> None:
@@ -207,7 +209,7 @@ class AutoStrokeController:
         heading = attitude_of(state, self.current.stroke.start.posture).heading_rad
         ask = Ask(float(np.linalg.norm(goal - position)), target_speed_m_s(self.target, state.time_s),
                   bearing_error(position, goal, heading), self._asked_m_s(state.time_s, position),
-                  self.surface_z_m() - float(goal[2]))
+                  self.medium().surface_z_m - float(goal[2]))
         return self.choice_rule.choose(self.active, ask, self.abilities)
 
     def _asked_m_s(self, time_s: float, position_m: np.ndarray) -> float:
@@ -216,8 +218,7 @@ class AutoStrokeController:
         velocity = target_velocity_m_s(self.target, time_s)
         if np.linalg.norm(velocity) > self.choice_rule.jumped_beyond_m_s:
             velocity = np.zeros(3)
-        if self.water_at is not None:
-            velocity = velocity - self.water_at(position_m, time_s)
+        velocity = velocity - self.medium().current_at(position_m, time_s)[0]
         return float(np.hypot(velocity[0], velocity[1]))
 
     def _hold_changes_now(self, state: BodyState) -> bool:
