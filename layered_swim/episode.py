@@ -71,7 +71,8 @@ WIDE_JITTER = StartJitter(heading_rad=math.radians(10.0), position_m=0.3)
 
 class Episode:
     def __init__(self, stroke: str, task: Task | None = None, *, medium: Medium = Medium(), backend: str = "plate",
-                 fluid_settings=None, lung_air_l: float | None = None, physics_hz: int = PHYSICS_HZ, tempo: float = 1.0,
+                 fluid_settings=None, lung_air_l: float | None = None, physics_hz: int = PHYSICS_HZ,
+                 integrator: str = DEFAULT_SIM.integrator, tempo: float = 1.0,
                  layers: Layers = Layers(), weights: CycleChooser | None = None,
                  tempo_control: TempoControl | None = None, seed: int = 0, jitter: StartJitter = START_JITTER,
                  wrap: Callable[[object, JointLayout], object] | None = None):
@@ -90,7 +91,7 @@ class Episode:
         first = next(iter(paths))
         self.stroke_spec: StrokeSpec = specs[first]
         self.stroke: Stroke = strokes[first]
-        config = DEFAULT_SIM.at(physics_hz)
+        config = replace(DEFAULT_SIM.at(physics_hz), integrator=integrator)
         fluid = make_fluid(backend, self.body, medium, config.gravity_m_s2, fluid_settings)
         try:
             controller = self._build_controller(stroke, strokes, layout, layers, weights, tempo, tempo_control, fluid)

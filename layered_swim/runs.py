@@ -355,7 +355,8 @@ def repeatable(config_path: str | Path) -> tuple[str, SwimSpec]:
     if command not in REPEATABLE or not isinstance(config.get("swim"), dict):
         raise ConfigError(f"{config_path}: not the config.json of a {', '.join(REPEATABLE)} folder of this version "
                           "(no command and swim)")
-    return command, parse(SwimSpec, config["swim"], f"{config_path}: swim")
+    # Folders from before the own integrator were stepped by PyBullet: so they are again.
+    return command, parse(SwimSpec, {"integrator": "bullet", **config["swim"]}, f"{config_path}: swim")
 
 
 def _expect(spec: SwimSpec, task: type, command: str) -> None:
@@ -447,7 +448,8 @@ def bench_sph(seconds: float = 0.5, settings=None, stroke: str = "breaststroke")
             "build_s": report["build_s"]}
 
 
-def bench_step(seconds: float = 5.0, physics_hz: int | None = None, stroke: str | None = None) -> dict:
+def bench_step(seconds: float = 5.0, physics_hz: int | None = None, stroke: str | None = None,
+               integrator: str = "own") -> dict:
     """Microseconds per physics step: (a) the bare PyBullet step of the floating body (no fluid,
     no PD), (b) the whole loop (state read, fluid, wrenches, PD, step) through the episode runner.
     Each is timed BENCH_REPEATS times, alternating so that a burst of load elsewhere hits both, and
@@ -455,14 +457,14 @@ def bench_step(seconds: float = 5.0, physics_hz: int | None = None, stroke: str 
     check_seconds(seconds)
     if stroke is None:
         stroke = "front_crawl" if "front_crawl" in available_strokes() else "rest"
-    episode = Episode(stroke) if physics_hz is None else Episode(stroke, physics_hz=physics_hz)
+    episode = Episode(stroke, integrator=integrator, **({} if physics_hz is None else {"physics_hz": physics_hz}))
     physics_hz = episode.sim.config.physics_hz
     steps = int(round(seconds * physics_hz))
     world = episode.sim.world
 
     def bare() -> None:
-        for _ in range(steps):   # PyBullet alone: the reference the loop is measured against
-            world.step()
+        for _ in range(steps):   # PyBullet's step alone: the reference the loop is measured against
+            world.step_bullet()
 
     def timed(run) -> float:
         episode.reset()
@@ -476,6 +478,7 @@ def bench_step(seconds: float = 5.0, physics_hz: int | None = None, stroke: str 
         bare_us, loop_us = min(p[0] for p in pairs), min(p[1] for p in pairs)
     finally:
         episode.close()
-    return {"stroke": episode.stroke.name, "physics_hz": physics_hz, "steps": steps, "repeats": BENCH_REPEATS,
+    return {"stroke": episode.stroke.name, "physics_hz": physics_hz, "integrator": integrator, "steps": steps,
+            "repeats": BENCH_REPEATS,
             "bare_step_us": bare_us, "loop_step_us": loop_us, "loop_to_bare_ratio": loop_us / bare_us,
             "realtime_factor": 1e6 / (loop_us * physics_hz)}

@@ -76,6 +76,7 @@ class SwimSpec(Strict):
     sph: dict | None = None                     # the SPH settings' fields (backend sph)
     plate: dict | None = None                   # the thin plates' settings' fields (backend plate), e.g. added_mass
     physics_hz: int = Field(PHYSICS_HZ, ge=120, le=5000)
+    integrator: Literal["own", "bullet"] = "own"    # who steps the body (sim/integrator.py): ours, or PyBullet
     log_hz: int = Field(DEFAULT_LOG_HZ, ge=1, le=5000)
     tempo: between(0.1, 5.0) = 1.0
     lung_air_l: between(0.0, 8.0) | None = None
@@ -135,6 +136,7 @@ class SwimSpec(Strict):
             built = FreeSwim(sample_hz=self.log_hz)
         return Episode(self.stroke, built, medium=self.medium.medium(), backend=self.backend,
                        fluid_settings=self.fluid_settings(), lung_air_l=self.lung_air_l, physics_hz=self.physics_hz,
+                       integrator=self.integrator,
                        tempo=self.tempo, layers=layers or self.layer_set,
                        tempo_control=GOAL_TEMPO if isinstance(task, GoalTask) else None, seed=self.seed,
                        jitter=JITTERS[self.jitter], wrap=wrap)

@@ -35,11 +35,13 @@ def run(args) -> None:
 
         if args.workers is not None and not 1 <= args.workers <= 64:
             raise ConfigError(f"--workers must be in 1..64, got {args.workers}")
-        result = bench_env(10.0 if args.seconds is None else args.seconds, workers=args.workers)
+        result = bench_env(10.0 if args.seconds is None else args.seconds, workers=args.workers,
+                           integrator=args.integrator)
     elif args.backend == "sph":
         result = bench_sph(0.5 if args.seconds is None else args.seconds, fluid_settings(args))
     else:
-        result = bench_step(5.0 if args.seconds is None else args.seconds, args.physics_hz)
+        result = bench_step(5.0 if args.seconds is None else args.seconds, args.physics_hz,
+                            integrator=args.integrator)
     if args.json:
         print(json.dumps(result))
         return

@@ -80,6 +80,9 @@ def backend_option(command: argparse.ArgumentParser, pool: str | None = "small")
     command.add_argument("--backend", default="plate",
                          help="fluid model: plate (thin plates + buoyancy, default) or sph (SPlisHSPlasH, "
                               "the [sph] extra)")
+    command.add_argument("--integrator", choices=("own", "bullet"), default="own",
+                         help="who steps the body: own (default: PyBullet's integration, compiled; docs/cli.md) "
+                              "or bullet (PyBullet's step)")
     sph = command.add_argument_group("SPH water (with --backend sph)")
     if pool:
         sph.add_argument("--pool", choices=("small", "large"), default=pool,
@@ -122,7 +125,8 @@ def swim_spec(args, stroke: str, task: dict, **fields):
     from layered_swim.spec import SwimSpec, sph_fields
 
     return SwimSpec.of("the command line", stroke=stroke, task=task, backend=args.backend,
-                       sph=sph_fields(fluid_settings(args)), plate=plate_fields(args), **fields)
+                       sph=sph_fields(fluid_settings(args)), plate=plate_fields(args),
+                       integrator=args.integrator, **fields)
 
 
 def medium(args, current: bool = True) -> dict:

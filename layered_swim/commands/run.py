@@ -20,8 +20,8 @@ from layered_swim.commands.options import (
 from layered_swim.commands.tables import flat, fmt, table
 
 # What describes the swim itself: with --config these come from the file, so none may be given.
-SWIM_OPTIONS = ("stroke", "seconds", "lung_air_l", "density", "fluid", "seed", "physics_hz", "tempo", "backend",
-                "pool", "water_depth", "particle_radius", "threads", "deterministic", "added_mass")
+SWIM_OPTIONS = ("stroke", "seconds", "lung_air_l", "density", "fluid", "seed", "physics_hz", "integrator", "tempo",
+                "backend", "pool", "water_depth", "particle_radius", "threads", "deterministic", "added_mass")
 
 
 def add_parser(subparsers) -> None:

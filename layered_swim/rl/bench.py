@@ -16,27 +16,27 @@ from layered_swim.rl.rollouts import make_env
 
 
 def bench_env(seconds: float = 10.0, env_state: str = "SmoothFT", hidden: tuple[int, ...] = (256, 256),
-              workers: int | None = None) -> dict:
+              workers: int | None = None, integrator: str = "own") -> dict:
     """Environment steps over about ``seconds`` of simulated time with a fresh policy, one thread;
     then ``workers`` processes (default: the shipped training config's ``run.workers``) doing the
     same at once, each on its own core as the trainer's rollout workers run: the steps per second
     all of them make together (0 or 1 worker: none)."""
-    result = _bench_one(seconds, env_state, hidden)
+    result = _bench_one(seconds, env_state, hidden, integrator)
     if workers is None:
         from layered_swim.rl.config import load_train_spec
 
         workers = load_train_spec(None).run.workers
     if workers > 1:
-        result.update(_bench_workers(seconds, env_state, hidden, workers))
+        result.update(_bench_workers(seconds, env_state, hidden, workers, integrator))
     return result
 
 
-def _bench_workers(seconds: float, env_state: str, hidden: tuple[int, ...], workers: int) -> dict:
+def _bench_workers(seconds: float, env_state: str, hidden: tuple[int, ...], workers: int, integrator: str) -> dict:
     """Every worker builds its environment, waits for the others, then steps: the rate is all
     their steps over the span from the first start to the last finish."""
     context = multiprocessing.get_context("spawn")     # as the trainer's pool: PyBullet and torch do not survive fork
     barrier, results = context.Barrier(workers), context.Queue()
-    procs = [context.Process(target=_worker, args=(seconds, env_state, hidden, barrier, results))
+    procs = [context.Process(target=_worker, args=(seconds, env_state, hidden, integrator, barrier, results))
              for _ in range(workers)]
     for p in procs:
         p.start()
@@ -51,13 +51,13 @@ def _bench_workers(seconds: float, env_state: str, hidden: tuple[int, ...], work
             "env_steps_per_s_per_worker": [r["env_steps_per_s_per_core"] for r in runs]}
 
 
-def _worker(seconds, env_state, hidden, barrier, results) -> None:
-    results.put(_bench_one(seconds, env_state, tuple(hidden), barrier))
+def _worker(seconds, env_state, hidden, integrator, barrier, results) -> None:
+    results.put(_bench_one(seconds, env_state, tuple(hidden), integrator, barrier))
 
 
-def _bench_one(seconds: float, env_state: str, hidden: tuple[int, ...], barrier=None) -> dict:
+def _bench_one(seconds: float, env_state: str, hidden: tuple[int, ...], integrator: str, barrier=None) -> dict:
     torch.set_num_threads(1)
-    env = make_env({"env_state": env_state, "reference": "layered"})
+    env = make_env({"env_state": env_state, "reference": "layered", "integrator": integrator})
     actor = ActorSnapshot(ActorCritic(env.observation_space.shape[0], env.action_space.shape[0], hidden))
     normaliser = Normaliser(env.observation_space.shape[0])
     rng = np.random.default_rng(0)
@@ -92,4 +92,5 @@ def _bench_one(seconds: float, env_state: str, hidden: tuple[int, ...], barrier=
             "share_reward": round(t["reward_s"] / wall_s, 3), "share_policy": round(policy_s / wall_s, 3),
             "env_overhead_vs_physics": round(env_added / physics, 3),
             "policy_vs_physics": round(policy_s / physics, 3), "env_state": env_state, "hidden": list(hidden),
+            "integrator": integrator,
             **({"start": started, "end": ended} if barrier is not None else {})}

@@ -115,7 +115,7 @@ class SwimGoalEnv(gym.Env):
                  reward_weights: RewardSpec | dict = RewardSpec(), backend: str = "plate", fluid_settings=None,
                  current_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0), goal: int | None = None,
                  start_jitter: bool = False, density_kg_m3: float | None = None,
-                 draws: DrawsSpec | dict | None = None):
+                 draws: DrawsSpec | dict | None = None, integrator: str = "own"):
         if isinstance(reward_weights, dict):     # gym.make's keyword arguments: checked like the YAML's reward section
             reward_weights = parse(RewardSpec, reward_weights, "the environment's reward_weights")
         if isinstance(draws, dict):
@@ -129,7 +129,7 @@ class SwimGoalEnv(gym.Env):
         self.reward_weights, self.fixed_goal, self.start_jitter = reward_weights, goal, start_jitter
         spec = SwimSpec.of("the environment", stroke=stroke, task={"kind": "goal", "pool": pool},
                            medium={"current_m_s": current_m_s, "density_kg_m3": density_kg_m3},
-                           layers=REFERENCES[reference], backend=backend,
+                           layers=REFERENCES[reference], backend=backend, integrator=integrator,
                            sph=sph_fields(fluid_settings))
         self.episode = goal_episode(spec, wrap=ResidualController)
         sim = self.episode.sim

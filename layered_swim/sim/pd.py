@@ -22,9 +22,10 @@ from layered_swim.sim.articulation import SPHERICAL, generalized_forces, mass_ma
 
 
 @njit(cache=True)
-def _cholesky_solve(a, b):
-    """Solve a x = b for symmetric positive definite ``a`` (overwritten by its factor). The mass
-    matrix's tree sparsity would save flops but not time at 39 rates: the dense loops pipeline."""
+def cholesky_factor(a):
+    """Factor symmetric positive definite ``a`` in place: its lower triangle becomes L, a = L L^T.
+    The mass matrix's tree sparsity would save flops but not time at 39 rates: the dense loops
+    pipeline."""
     n = a.shape[0]
     for j in range(n):
         d = a[j, j]
@@ -37,15 +38,21 @@ def _cholesky_solve(a, b):
             for k in range(j):
                 s -= a[i, k] * a[j, k]
             a[i, j] = s / d
+
+
+@njit(cache=True)
+def cholesky_substitute(factor, b):
+    """Solve L L^T x = b with ``factor`` from ``cholesky_factor``."""
+    n = factor.shape[0]
     x = b.copy()
     for i in range(n):
         for k in range(i):
-            x[i] -= a[i, k] * x[k]
-        x[i] /= a[i, i]
+            x[i] -= factor[i, k] * x[k]
+        x[i] /= factor[i, i]
     for i in range(n - 1, -1, -1):
         for k in range(i + 1, n):
-            x[i] -= a[k, i] * x[k]
-        x[i] /= a[i, i]
+            x[i] -= factor[k, i] * x[k]
+        x[i] /= factor[i, i]
     return x
 
 
@@ -97,7 +104,8 @@ def stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt):
     for k in range(n):
         mass[k, k] += dt * kd[k]
         rhs[k] = kp[k] * error[k] + kd[k] * (target_qd[k] - qd[k]) - bias[k]
-    qdd = _cholesky_solve(mass, rhs)
+    cholesky_factor(mass)
+    qdd = cholesky_substitute(mass, rhs)
     tau = np.empty(n)
     for k in range(n):
         t = kp[k] * error[k] + kd[k] * (target_qd[k] - qd[k] - dt * qdd[k])
@@ -107,16 +115,20 @@ def stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt):
 
 @njit(cache=True)
 def loads_and_pd(index, params, frames, s, rows, force, torque, at, q, qd, target_q, target_qd, gains, dt,
-                 gravity_m_s2, base_wrench, tau, total):
+                 gravity_m_s2, base_wrench, tau, total, mass_out, bias_out):
     """One call for a physics step's joint-space loads: the generalised forces of one wrench per
     body (``articulation.generalized_forces``), the stable PD torques (``stable_pd_torques`` on
     ``articulation.mass_matrix_and_bias``) and their sum on the joints' rates (zero on the base's,
     whose wrench PyBullet takes apart). The same arithmetic as the three calls one by one: the
     same bits, a third of the call overhead. Writes the base's wrench (moment; force) into
     ``base_wrench`` (6,), the PD torques into ``tau`` and the joints' total into ``total``
-    (n_dof,): arrays a call returns cost Python more than these kernels' own arithmetic."""
+    (n_dof,): arrays a call returns cost Python more than these kernels' own arithmetic; and, where
+    ``mass_out`` is not empty, the mass matrix and bias forces into ``mass_out`` and ``bias_out``."""
     load = generalized_forces(index, frames, s, rows, force, torque, at)
     mass, bias = mass_matrix_and_bias(index, params, frames, s, gravity_m_s2)
+    if mass_out.shape[0] > 0:       # stepping without PyBullet (``sim/integrator.py``) needs them after PD
+        mass_out[:, :] = mass
+        bias_out[:] = bias
     tau[:] = stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt)
     for k in range(tau.shape[0]):
         total[k] = (load[k] if k >= 6 else 0.0) + tau[k]

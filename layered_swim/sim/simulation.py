@@ -19,7 +19,7 @@ from layered_swim.body.model import Body
 from layered_swim.config import ConfigError
 from layered_swim.fluid.backend import FluidBackend, FluidWrenches
 from layered_swim.geometry import quat_multiply
-from layered_swim.sim.world import World
+from layered_swim.sim.world import INTEGRATORS, World
 from layered_swim.state import BodyState, JointLayout, Start
 
 PRONE_QUAT_XYZW = (0.0, math.sqrt(0.5), 0.0, math.sqrt(0.5))  # standing frame pitched 90 deg: head +x, face down
@@ -66,6 +66,7 @@ class SimConfig:
     physics_hz: int
     control_hz: int
     gravity_m_s2: float
+    integrator: str = "own"     # who steps the body: our own (sim/integrator.py), or PyBullet
 
     def __post_init__(self):
         if self.physics_hz < 120 or self.physics_hz > 5000:
@@ -74,6 +75,8 @@ class SimConfig:
             raise ConfigError(f"control rate {self.control_hz} Hz must divide the physics rate {self.physics_hz} Hz")
         if not (math.isfinite(self.gravity_m_s2) and 0.0 <= self.gravity_m_s2 <= 100.0):
             raise ConfigError(f"gravity must be in 0..100 m/s^2, got {self.gravity_m_s2}")
+        if self.integrator not in INTEGRATORS:
+            raise ConfigError(f"integrator must be one of {', '.join(INTEGRATORS)}, got {self.integrator!r}")
 
     def at(self, physics_hz: int) -> "SimConfig":
         return replace(self, physics_hz=physics_hz)
@@ -92,7 +95,7 @@ class Simulation:
         self.controller = controller
         self.fluid = fluid
         self.config = config
-        self.world = World(body, self.layout, config.physics_hz, config.gravity_m_s2, pd_gain_scale)
+        self.world = World(body, self.layout, config.physics_hz, config.gravity_m_s2, pd_gain_scale, config.integrator)
         self.control_every = config.physics_hz // config.control_hz
         self.steps = 0
         self.state: BodyState | None = None
@@ -159,8 +162,7 @@ class Simulation:
             if air is not None:
                 self._breathe(air)
         force = fluid.force_n if self.external_force_n is None else fluid.force_n + self.external_force_n
-        self.world.drive_with_wrenches(force, fluid.torque_nm, state.pos_m)
-        self.world.step()
+        self.world.drive_and_step(force, fluid.torque_nm, state.pos_m)
         self.steps += 1
         self.state = self.world.read_state()
         if not _all_within(self.state.linvel_m_s, MAX_SPEED_M_S):

@@ -10,6 +10,10 @@ PyBullet's STABLE_PD_CONTROL builds a second model of the body and solves it on 
 than a third of the whole step; ``layered_swim.sim.pd`` computes the same torques (tested
 against it) and PyBullet only applies them.
 
+With ``integrator="own"`` the World steps the body itself (``layered_swim.sim.integrator``: the
+same integration as PyBullet's, from the mass matrix stable PD already has) and PyBullet only
+loads and places the body: no state reads, torque writes or PyBullet steps per step.
+
 The per-step calls go to the ``pybullet`` functions with the World's own client id rather than
 through ``BulletClient``: its attribute lookup builds a new partial per call, which cost about as
 much as the 32 force calls themselves.
@@ -42,6 +46,7 @@ from layered_swim.sim.articulation import (
     generalized_forces,
     mass_matrix_and_bias,
 )
+from layered_swim.sim.integrator import LIMIT_ERP, advance, drive_and_advance
 from layered_swim.sim.pd import loads_and_pd, stable_pd_torques
 from layered_swim.state import BodyState, JointLayout
 
@@ -96,9 +101,18 @@ def _tree(client, uid: int) -> Tree:
                 np.array(axis, dtype=float), np.array(mass, dtype=float), np.array(inertia, dtype=float))
 
 
+INTEGRATORS = ("bullet", "own")
+
+
 class World:
     def __init__(self, body: Body, layout: JointLayout, physics_hz: float, gravity_m_s2: float,
-                 pd_gain_scale: dict[str, float] | None = None):
+                 pd_gain_scale: dict[str, float] | None = None, integrator: str = "bullet"):
+        """``integrator``: ``bullet`` (PyBullet steps the body) or ``own`` (``sim/integrator.py``;
+        it has no contacts, so while a pool's walls stand PyBullet steps the body anyway)."""
+        if integrator not in INTEGRATORS:
+            raise ValueError(f"integrator must be one of {', '.join(INTEGRATORS)}, got {integrator!r}")
+        self.integrator = integrator
+        self.own = integrator == "own"      # stepping itself now (not while walls stand)
         self.body = body
         self.layout = layout
         self.dt_s = 1.0 / physics_hz
@@ -168,6 +182,18 @@ class World:
         self._total = np.zeros(tree.n_dof)       # the step's joint loads, written in place each step
         self._base_wrench = np.zeros(6)
         self._pending: np.ndarray | None = None   # generalised forces for the next step: PD and wrenches
+        # Stepping itself: the mass matrix and bias forces that stable PD computed for this state
+        # (kept, since PD uses its copy up), and each revolute joint's limits (rate index, position
+        # index, lower, upper) as PyBullet's URDF importer makes them (lower <= upper).
+        self._dynamics_fresh = False
+        self._mass, self._bias = np.zeros((tree.n_dof, tree.n_dof)), np.zeros(tree.n_dof)
+        self._no_mass, self._no_bias = np.zeros((0, 0)), np.zeros(0)     # stepped by PyBullet: not kept
+        limits = []
+        for j in self._joints:
+            info = c.getJointInfo(self.uid, j)
+            if info[2] == pybullet.JOINT_REVOLUTE and info[8] <= info[9]:
+                limits.append((tree.rates_of(j + 1).start, tree.positions_of(j + 1).start, info[8], info[9]))
+        self._limits = np.array(limits, dtype=np.float64).reshape(-1, 4)
         self._walls: list[int] = []                # static bodies of a pool the swimmer touches
 
     # --- state -------------------------------------------------------------------------
@@ -185,6 +211,10 @@ class World:
         self._torque[:] = 0.0
         self._pending = None
         self._fresh = False
+        self._dynamics_fresh = False
+        if self.own:      # from here on the World holds the coordinates itself
+            self._read_coordinates()
+            self._q, self._qd = self._q.copy(), self._qd.copy()
 
     def set_pool(self, min_m, max_m, thickness_m: float = 0.1) -> None:
         """A floor and four walls on the faces of the box ``[min_m, max_m]`` that the swimmer
@@ -195,6 +225,13 @@ class World:
             c.removeBody(uid)
         self._walls = []
         touching = min_m is not None
+        own = self.integrator == "own" and not touching
+        if own and not self.own:        # on from PyBullet's state
+            self._read_coordinates()
+            self._q, self._qd = self._q.copy(), self._qd.copy()
+        elif self.own and not own:      # PyBullet on from ours
+            self._write_coordinates()
+        self.own, self._fresh = own, False
         for link in [-1, *self._joints]:
             c.setCollisionFilterGroupMask(self.uid, link, int(touching), 2 * int(touching))
         if not touching:
@@ -219,7 +256,7 @@ class World:
     def time_s(self) -> float:
         return self.steps * self.dt_s  # a product, not a running sum: no drift over long runs
 
-    def read_state(self) -> BodyState:
+    def _read_coordinates(self) -> None:
         uid, cid, tree = self.uid, self._cid, self.tree
         base_pos, base_quat = pybullet.getBasePositionAndOrientation(uid, cid)
         base_lin, base_ang = pybullet.getBaseVelocity(uid, cid)
@@ -228,7 +265,22 @@ class World:
         flat = np.fromiter(chain(base_pos, base_quat, _flatten(map(_JOINT_POSITION, joints)), base_ang, base_lin,
                                  _flatten(map(_JOINT_RATE, joints))), np.float64, self._state_size)
         self._q, self._qd = flat[:tree.n_positions], flat[tree.n_positions:]
-        forward_kinematics(tree.index, tree.params, self._q, self._qd, self._frames, self._subspace)
+
+    def _write_coordinates(self) -> None:
+        uid, cid, q, qd = self.uid, self._cid, self._q, self._qd
+        pybullet.resetBasePositionAndOrientation(uid, q[0:3].tolist(), q[3:7].tolist(), cid)
+        pybullet.resetBaseVelocity(uid, qd[3:6].tolist(), qd[0:3].tolist(), cid)
+        for j in self._joints:
+            at, rates = self.tree.positions_of(j + 1), self.tree.rates_of(j + 1)
+            pybullet.resetJointStateMultiDof(uid, j, q[at.start:at.stop].tolist(), qd[rates.start:rates.stop].tolist(),
+                                             physicsClientId=cid)
+
+    def read_state(self) -> BodyState:
+        tree = self.tree
+        if not self.own:
+            self._read_coordinates()
+        if not (self.own and self._fresh):      # stepping itself, the step left the kinematics fresh
+            forward_kinematics(tree.index, tree.params, self._q, self._qd, self._frames, self._subspace)
         self._fresh = True
         segments = self._frames[self._segment_rows]
         return BodyState(self.time_s, segments[:, POS], segments[:, QUAT], segments[:, LINVEL], segments[:, ANGVEL],
@@ -266,6 +318,9 @@ class World:
         self._ensure_fresh()
         load = generalized_forces(self.tree.index, self._frames, self._subspace, self._segment_rows, force_n,
                                   torque_nm, at_m)
+        if self.own:
+            self._add_pending(load)
+            return
         uid, cid, frame = self.uid, self._cid, pybullet.WORLD_FRAME
         pybullet.applyExternalForce(uid, -1, load[3:6].tolist(), self._q[0:3].tolist(), frame, cid)
         pybullet.applyExternalTorque(uid, -1, load[0:3].tolist(), frame, cid)
@@ -280,12 +335,34 @@ class World:
         base, total = self._base_wrench, self._total
         loads_and_pd(tree.index, tree.params, self._frames, self._subspace, self._segment_rows, force_n, torque_nm,
                      at_m, self._q, self._qd, self._target_q, self._target_qd, self._gains, self.dt_s,
-                     self.gravity_m_s2, base, self._torque, total)
+                     self.gravity_m_s2, base, self._torque, total, *((self._mass, self._bias) if self.own else
+                                                                     (self._no_mass, self._no_bias)))
+        if self.own:
+            self._dynamics_fresh = True
+            total[0:6] = base
+            self._add_pending(total)
+            return
         uid, cid, frame = self.uid, self._cid, pybullet.WORLD_FRAME
         wrench = base.tolist()
         pybullet.applyExternalForce(uid, -1, wrench[3:6], self._q[0:3].tolist(), frame, cid)
         pybullet.applyExternalTorque(uid, -1, wrench[0:3], frame, cid)
         self._add_pending(total)
+
+    def drive_and_step(self, force_n: np.ndarray, torque_nm: np.ndarray, at_m: np.ndarray) -> None:
+        """``drive_with_wrenches`` then ``step``: with the own integrator, one compiled call that
+        also leaves the new state's kinematics ready for ``read_state``."""
+        if not self.own or self._pending is not None:
+            self.drive_with_wrenches(force_n, torque_nm, at_m)
+            self.step()
+            return
+        self._ensure_fresh()
+        tree = self.tree
+        drive_and_advance(tree.index, tree.params, self._frames, self._subspace, self._segment_rows, force_n,
+                          torque_nm, at_m, self._q, self._qd, self._target_q, self._target_qd, self._gains, self.dt_s,
+                          self.gravity_m_s2, self._base_wrench, self._torque, self._total, self._mass, self._bias,
+                          self._limits, LIMIT_ERP)
+        self.steps += 1
+        self._fresh, self._dynamics_fresh = True, False
 
     def set_targets(self, pose: np.ndarray, rates: np.ndarray) -> None:
         """Convert a desired pose and its rates into the joints' targets (at control rate)."""
@@ -299,6 +376,9 @@ class World:
         self._ensure_fresh()
         tree = self.tree
         mass, bias = mass_matrix_and_bias(tree.index, tree.params, self._frames, self._subspace, self.gravity_m_s2)
+        if self.own:
+            self._mass[:], self._bias[:] = mass, bias
+            self._dynamics_fresh = True
         self._torque = stable_pd_torques(mass, bias, tree.index, self._q, self._qd, self._target_q, self._target_qd,
                                          self._gains, self.dt_s)
         self._add_pending(self._torque)
@@ -307,6 +387,9 @@ class World:
         self._pending = generalised if self._pending is None else self._pending + generalised
 
     def step(self) -> None:
+        if self.own:
+            self._step_own()
+            return
         if self._pending is not None:
             # All joint torques in one call; PyBullet clears them after the step.
             flat = self._pending.tolist()
@@ -317,6 +400,23 @@ class World:
         pybullet.stepSimulation(physicsClientId=self._cid)
         self.steps += 1
         self._fresh = False
+
+    def _step_own(self) -> None:
+        self._ensure_fresh()
+        tree = self.tree
+        if not self._dynamics_fresh:
+            self._mass[:], self._bias[:] = mass_matrix_and_bias(tree.index, tree.params, self._frames, self._subspace,
+                                                                self.gravity_m_s2)
+        load = self._pending if self._pending is not None else np.zeros(tree.n_dof)
+        advance(tree.index, self._mass, self._bias, load, self._q, self._qd, self.dt_s, self._limits, LIMIT_ERP)
+        self._pending = None
+        self.steps += 1
+        self._fresh = self._dynamics_fresh = False
+
+    def step_bullet(self) -> None:
+        """PyBullet's own step of the body and nothing else: the floor ``bench`` measures against
+        (it moves PyBullet's copy of the body only; the World's state is not read back)."""
+        pybullet.stepSimulation(physicsClientId=self._cid)
 
     def close(self) -> None:
         with contextlib.suppress(Exception):
