@@ -112,7 +112,7 @@ class JointLayout:
         return np.zeros(self.size)
 
     def clamp(self, pose: np.ndarray) -> np.ndarray:
-        return np.clip(pose, self.lower_rad, self.upper_rad)
+        return _clipped(pose, self.lower_rad, self.upper_rad)
 
     def ball_targets(self, pose: np.ndarray, rates: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Ball joints' child-in-parent quaternions (n_ball, 4) and child-frame angular
@@ -121,6 +121,17 @@ class JointLayout:
 
     def ball_quaternions(self, pose: np.ndarray) -> np.ndarray:
         return self.ball_targets(pose, np.zeros_like(pose))[0]
+
+
+@njit(cache=True)
+def _clipped(x, low, high):
+    """``np.clip(x, low, high)`` for (n,) float arrays, compiled (twice a control step): numpy's own
+    rule, a NaN kept and a tie going to the bound, so the same bits."""
+    out = np.empty(x.shape[0])
+    for k in range(x.shape[0]):
+        v = x[k] if (x[k] > low[k] or x[k] != x[k]) else low[k]
+        out[k] = v if (v < high[k] or v != v) else high[k]
+    return out
 
 
 @njit(cache=True)

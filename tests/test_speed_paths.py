@@ -1,6 +1,7 @@
 """The physics step's fast paths give numpy's own bits: the compiled single-quaternion rotation
 and cross product, the one-call wrench + stable PD loads, the compiled hand rules, the goal
-line's one-time position and the plates' one call with the added mass."""
+line's one-time position, the plates' one call with the added mass, and the controller's and the
+environment's compiled helpers."""
 import math
 
 import numpy as np
@@ -130,3 +131,41 @@ def test_the_plates_one_call_with_the_added_mass_equals_the_two_summed():
         assert fluid.wrenches(episode.sim.state).force_n.tobytes() == again.force_n.tobytes()
     finally:
         episode.close()
+
+
+def test_the_controller_and_environments_compiled_helpers_are_numpys_bits():
+    from layered_swim.control.stroke import TABLE_SAMPLES, CyclicTable
+    from layered_swim.rl.env import _add_into
+    from layered_swim.rl.observation import to_heading_frame
+    from layered_swim.sim.world import _scatter
+    from layered_swim.state import _clipped
+
+    rng = np.random.default_rng(5)
+    table = CyclicTable(rng.normal(size=(TABLE_SAMPLES + 1, 41)), rng.normal(size=(TABLE_SAMPLES + 1, 41)))
+    for phase in rng.uniform(-3.0, 3.0, 300):
+        x = (phase % 1.0) * TABLE_SAMPLES
+        i = min(int(x), TABLE_SAMPLES - 1)
+        w = x - i
+        pose, rate = table.at(phase)
+        assert pose.tobytes() == (table.values[i] * (1.0 - w) + table.values[i + 1] * w).tobytes()
+        assert rate.tobytes() == (table.rates[i] * (1.0 - w) + table.rates[i + 1] * w).tobytes()
+    for shape in ((3,), (16, 3), (4, 3)):
+        v, heading = rng.normal(size=shape), rng.uniform(-4.0, 4.0)
+        c, s = math.cos(heading), math.sin(heading)
+        expected = np.stack([c * v[..., 0] + s * v[..., 1], -s * v[..., 0] + c * v[..., 1], v[..., 2]], axis=-1)
+        assert to_heading_frame(v, heading).tobytes() == expected.tobytes()
+    first, then = rng.normal(size=8), rng.normal(size=5)
+    at, source = rng.permutation(13)[:10], rng.permutation(13)[:10]
+    into, expected = np.zeros(13), np.zeros(13)
+    _scatter(into, at, source, first, then)
+    expected[at] = np.concatenate([first, then])[source]
+    assert into.tobytes() == expected.tobytes()
+    low = rng.normal(size=41) - 1.0
+    high = low + rng.uniform(0.0, 2.0, 41)
+    pose = rng.normal(size=41) * 2.0
+    pose[:4], low[1], high[1] = (np.nan, -0.0, low[2], high[3]), 0.0, 1.0     # NaN, a signed zero, ties
+    assert _clipped(pose, low, high).tobytes() == np.clip(pose, low, high).tobytes()
+    force, torque, more_force, more_torque = (rng.normal(size=(16, 3)) for _ in range(4))
+    expected_force, expected_torque = force + more_force, torque + more_torque
+    _add_into(force, torque, more_force, more_torque)
+    assert force.tobytes() == expected_force.tobytes() and torque.tobytes() == expected_torque.tobytes()

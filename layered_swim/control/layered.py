@@ -18,7 +18,7 @@ import numpy as np
 from layered_swim.config import ConfigError
 from layered_swim.control.lungs import LungControl
 from layered_swim.control.rules import Arms, rule_offsets
-from layered_swim.control.steering import MeanAttitude, body_pitch, forward_axis, shoulder_roll
+from layered_swim.control.steering import MeanAttitude, elevation, forward_axis, shoulder_roll
 from layered_swim.control.stroke import ALL_SEQUENCES, Stroke
 from layered_swim.control.targets import Target
 from layered_swim.geometry import ease, unit_vector
@@ -142,23 +142,25 @@ class LayeredController:
                 pose = pose + weight * offset
                 rate = rate + weight * offset_rate
         if state is not None:
-            self._track_attitude(state)
+            forward = forward_axis(state.quat("pelvis"), self.stroke.start.posture)   # read once a step
+            self._track_attitude(state, forward)
             if self.lungs is not None and self.layers.cycle:      # depth is steered, like the heading
                 self._breathe(time_s, state)
             if self.layers.palm or self.layers.reach:
                 dt_s = time_s - self._last_rule_time_s if self._last_rule_time_s is not None else 0.0
                 self._last_rule_time_s = time_s
-                desired = self.desired_direction(state)
+                desired = self.desired_direction(state, forward)
                 self.rule_offsets = rule_offsets(self.rule_offsets, self.arms, self.stroke.rules, state.quat_xyzw,
-                                                 state.linvel_m_s, flow_m_s, desired, dt_s,
-                                                 self.layers.palm, self.layers.reach, self._engagement(state, desired))
+                                                 state.linvel_m_s, flow_m_s, desired, dt_s, self.layers.palm,
+                                                 self.layers.reach, self._engagement(forward, desired))
                 pose = pose + self.rule_offsets
         return self.layout.clamp(pose), rate * self.cycles_per_s
 
-    def desired_direction(self, state: BodyState) -> np.ndarray:
-        """Unit vector from the centre of mass to the target (the way the swimmer heads without one)."""
+    def desired_direction(self, state: BodyState, forward: np.ndarray) -> np.ndarray:
+        """Unit vector from the centre of mass to the target (without one, ``forward``: the way the
+        swimmer heads)."""
         if self.target is None:
-            return forward_axis(state.quat("pelvis"), self.stroke.start.posture)
+            return forward
         return unit_vector(self.target.position(state.time_s) - state.com_m)
 
     def _blended_weights(self, time_s: float) -> dict[str, float]:
@@ -175,12 +177,11 @@ class LayeredController:
                 + eased * (self.choice.weights.get(n, 0.0) - self._previous_weights.get(n, 0.0))
                 for n in names}
 
-    def _engagement(self, state: BodyState, desired: np.ndarray) -> float:
+    def _engagement(self, forward: np.ndarray, desired: np.ndarray) -> float:
         """How much the rules push: fully when the target is ahead and the cycle has no turn,
         fading as the target moves abeam or the yaw weight grows. While turning, the per-cycle
         layer's left-right asymmetry is what is wanted, and rules that maximise both hands'
         thrust would even it out."""
-        forward = forward_axis(state.quat("pelvis"), self.stroke.start.posture)
         turning = max(self.choice.weights.get("yaw_left", 0.0), self.choice.weights.get("yaw_right", 0.0))
         return max(0.0, float(forward @ desired)) ** 2 * max(0.0, 1.0 - turning) ** 3 * self.choice.thrust_demand
 
@@ -190,10 +191,10 @@ class LayeredController:
         self.lung_air_l = self.lungs.next_air_l(self.lung_air_l, -float(state.pos("pelvis")[2]),
                                                 -float(self.target.position(time_s)[2]), dt_s)
 
-    def _track_attitude(self, state: BodyState) -> None:
+    def _track_attitude(self, state: BodyState, forward: np.ndarray) -> None:
         """Accumulate the cycle's mean pitch and shoulder roll: a crawl rolls +-30 deg within a
         cycle, and a stroke's pitch swings with its phase, so steering reads the cycle average."""
-        self._pitch_sum += body_pitch(state.quat("pelvis"), self.stroke.start.posture)
+        self._pitch_sum += elevation(forward)
         self._roll_sum += shoulder_roll(state.quat("thorax"))
         self._attitude_n += 1
 

@@ -45,18 +45,14 @@ def shoulder_roll(thorax_quat: np.ndarray) -> float:
     return math.asin(max(-1.0, min(1.0, lateral_z)))
 
 
-def _elevation(forward: np.ndarray) -> float:
+def elevation(forward: np.ndarray) -> float:
+    """How far a unit axis points up (rad): the forward axis's is the body's pitch (+ nose up)."""
     return math.asin(max(-1.0, min(1.0, float(forward[2]))))
-
-
-def body_pitch(pelvis_quat: np.ndarray, posture: str) -> float:
-    """The forward axis's elevation (+ nose up)."""
-    return _elevation(forward_axis(pelvis_quat, posture))
 
 
 def attitude(pelvis_quat: np.ndarray, thorax_quat: np.ndarray, posture: str) -> Attitude:
     forward = forward_axis(pelvis_quat, posture)
-    return Attitude(math.atan2(forward[1], forward[0]), _elevation(forward), shoulder_roll(thorax_quat))
+    return Attitude(math.atan2(forward[1], forward[0]), elevation(forward), shoulder_roll(thorax_quat))
 
 
 def attitude_of(state: BodyState, posture: str) -> Attitude:

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
+from numba import njit
 from pydantic import Field, model_validator
 from scipy.interpolate import PchipInterpolator
 
@@ -203,9 +204,19 @@ class CyclicTable:
     def at(self, phase: float) -> tuple[np.ndarray, np.ndarray]:
         x = (phase % 1.0) * TABLE_SAMPLES
         i = min(int(x), TABLE_SAMPLES - 1)
-        w = x - i
-        return (self.values[i] * (1.0 - w) + self.values[i + 1] * w,
-                self.rates[i] * (1.0 - w) + self.rates[i + 1] * w)
+        return _between_rows(self.values, self.rates, i, x - i)
+
+
+@njit(cache=True)
+def _between_rows(values, rates, i, w):
+    """Rows i and i + 1 of both tables mixed by ``w``: numpy's ``a * (1 - w) + b * w`` element by
+    element, the same bits (the controller asks it several times a control step)."""
+    n = values.shape[1]
+    pose, rate = np.empty(n), np.empty(n)
+    for k in range(n):
+        pose[k] = values[i, k] * (1.0 - w) + values[i + 1, k] * w
+        rate[k] = rates[i, k] * (1.0 - w) + rates[i + 1, k] * w
+    return pose, rate
 
 
 @dataclass(frozen=True)

@@ -26,6 +26,7 @@ from typing import Any, NamedTuple
 
 import gymnasium as gym
 import numpy as np
+from numba import njit
 
 from layered_swim.config import ConfigError, parse
 from layered_swim.control.residual import ResidualController
@@ -42,6 +43,15 @@ from layered_swim.tasks import swim_benchmark as bench
 
 REFERENCES = {"basic": "basic", "layered": "basic,cycle,rules"}
 TRAINING_SEEDS = 1000       # jittered starts drawn in training start here; evaluation uses the seeds below
+
+
+@njit(cache=True)
+def _add_into(force, torque, more_force, more_torque):
+    """``force += more_force; torque += more_torque`` in one call (every physics step)."""
+    for i in range(force.shape[0]):
+        for c in range(3):
+            force[i, c] += more_force[i, c]
+            torque[i, c] += more_torque[i, c]
 
 
 class Push(NamedTuple):
@@ -191,8 +201,7 @@ class SwimGoalEnv(gym.Env):
                 if push is not None:
                     sim.push(push.force_n if push.from_s <= sim.time_s < push.to_s else 0.0)
                 episode.step()
-                force += sim.fluid_now.force_n
-                torque += sim.fluid_now.torque_nm
+                _add_into(force, torque, sim.fluid_now.force_n, sim.fluid_now.torque_nm)
         except (SimulationDiverged, FluidError) as err:
             episode.task.end(f"diverged: {err}", sim.time_s)
             return self._last_obs.copy(), 0.0, True, False, {"termination": episode.task.ended,

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from layered_swim.config import ConfigError
 
@@ -60,9 +61,21 @@ def layout_for(n_joint_positions: int, n_joint_rates: int, n_segments: int, env_
 
 def to_heading_frame(vectors: np.ndarray, heading_rad: float) -> np.ndarray:
     """World vectors (..., 3) turned by -heading about z."""
-    c, s = math.cos(heading_rad), math.sin(heading_rad)
     v = np.asarray(vectors, float)
-    return np.stack([c * v[..., 0] + s * v[..., 1], -s * v[..., 0] + c * v[..., 1], v[..., 2]], axis=-1)
+    return _turned(v.reshape(-1, 3), math.cos(heading_rad), math.sin(heading_rad)).reshape(v.shape)
+
+
+@njit(cache=True)
+def _turned(v, c, s):
+    """Rows of ``v`` turned: numpy's elementwise arithmetic, compiled (five numpy calls on a few
+    rows cost ~5 us, four times an environment step)."""
+    out = np.empty((v.shape[0], 3))
+    for i in range(v.shape[0]):
+        x, y = v[i, 0], v[i, 1]
+        out[i, 0] = c * x + s * y
+        out[i, 1] = -s * x + c * y
+        out[i, 2] = v[i, 2]
+    return out
 
 
 def phase_encoding(phase: float) -> np.ndarray:

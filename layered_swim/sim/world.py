@@ -29,6 +29,7 @@ from itertools import chain
 from pathlib import Path
 
 import numpy as np
+from numba import njit
 
 from layered_swim.body.model import Body
 from layered_swim.body.urdf import write_urdf
@@ -102,6 +103,16 @@ def _tree(client, uid: int) -> Tree:
 
 
 INTEGRATORS = ("bullet", "own")
+
+
+@njit(cache=True)
+def _scatter(into, at, source, first, then):
+    """``into[at] = concatenate([first, then])[source]``, without building the concatenation
+    (at control rate)."""
+    n_first = first.shape[0]
+    for m in range(at.shape[0]):
+        k = source[m]
+        into[at[m]] = first[k] if k < n_first else then[k - n_first]
 
 
 class World:
@@ -367,8 +378,8 @@ class World:
     def set_targets(self, pose: np.ndarray, rates: np.ndarray) -> None:
         """Convert a desired pose and its rates into the joints' targets (at control rate)."""
         quats, omegas = self.layout.ball_targets(pose, rates)
-        self._target_q[self._q_at] = np.concatenate([quats.ravel(), pose])[self._q_from]
-        self._target_qd[self._qd_at] = np.concatenate([omegas.ravel(), rates])[self._qd_from]
+        _scatter(self._target_q, self._q_at, self._q_from, quats.ravel(), pose)
+        _scatter(self._target_qd, self._qd_at, self._qd_from, omegas.ravel(), rates)
 
     def drive(self) -> None:
         """Stable PD toward the last targets from the current state: the torques hold for the
