@@ -49,6 +49,9 @@ class BodyState:
     linvel_m_s: np.ndarray     # (n, 3)
     angvel_rad_s: np.ndarray   # (n, 3)
     segments: Segments
+    # The centre of mass, worked out on first asking (the controller, observation and reward each
+    # ask it every control step); a state is a snapshot, its arrays never change after it is made.
+    _com_m: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def pos(self, segment: str) -> np.ndarray:
         return self.pos_m[self.segments.rows[segment]]
@@ -58,7 +61,9 @@ class BodyState:
 
     @property
     def com_m(self) -> np.ndarray:
-        return self.segments.centre_of_mass(self.pos_m)
+        if self._com_m is None:
+            self._com_m = self.segments.centre_of_mass(self.pos_m)
+        return self._com_m
 
     @property
     def com_vel_m_s(self) -> np.ndarray:

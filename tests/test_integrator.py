@@ -114,3 +114,40 @@ def test_an_unknown_integrator_is_one_clear_error():
         SwimSpec.of("test", stroke="front_crawl", integrator="rk4")
     with pytest.raises(ConfigError, match="integrator"):
         Episode("front_crawl", integrator="rk4")
+
+
+def test_the_trees_own_factorisation_solves_as_a_dense_one():
+    """``ltl_factor`` keeps to the mass matrix's tree sparsity; the solve and stable PD through it
+    agree with the dense Cholesky to rounding."""
+    from layered_swim.sim.articulation import ltl_factor, ltl_solve, mass_matrix_and_bias, parent_rates
+    from layered_swim.sim.pd import stable_pd_torques
+
+    episode = Episode("front_crawl")
+    try:
+        episode.run(1.0)
+        world = episode.sim.world
+        tree = world.tree
+        mass, bias = mass_matrix_and_bias(tree.index, tree.params, world._frames, world._subspace, 9.81)
+        parent = parent_rates(tree.index)
+        assert all(-1 <= p < k for k, p in enumerate(parent))
+        outside = [(i, j) for i in range(tree.n_dof) for j in range(i)
+                   if mass[i, j] != 0.0 and j not in _ancestors(parent, i)]
+        assert not outside, f"mass matrix entries off the tree: {outside[:5]}"
+        b = np.random.default_rng(0).normal(size=tree.n_dof)
+        factor = mass.copy()
+        ltl_factor(factor, parent)
+        np.testing.assert_allclose(ltl_solve(factor, parent, b), np.linalg.solve(mass, b), rtol=1e-9, atol=1e-9)
+        q, qd = world.kinematics()[:2]
+        args = (tree.index, q, qd, world._target_q, world._target_qd, world._gains, world.dt_s)
+        dense = stable_pd_torques(mass.copy(), bias, *args, np.zeros(0, dtype=np.int64))
+        np.testing.assert_allclose(stable_pd_torques(mass.copy(), bias, *args, parent), dense, rtol=1e-9, atol=1e-9)
+    finally:
+        episode.close()
+
+
+def _ancestors(parent, k):
+    found, j = set(), parent[k]
+    while j >= 0:
+        found.add(j)
+        j = parent[j]
+    return found

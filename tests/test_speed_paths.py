@@ -149,6 +149,10 @@ def test_the_controller_and_environments_compiled_helpers_are_numpys_bits():
         pose, rate = table.at(phase)
         assert pose.tobytes() == (table.values[i] * (1.0 - w) + table.values[i + 1] * w).tobytes()
         assert rate.tobytes() == (table.rates[i] * (1.0 - w) + table.rates[i + 1] * w).tobytes()
+        base_pose, base_rate, weight = rng.normal(size=41), rng.normal(size=41), rng.uniform(-1.5, 1.5)
+        added_pose, added_rate = table.added(base_pose, base_rate, weight, phase)
+        assert added_pose.tobytes() == (base_pose + weight * pose).tobytes()
+        assert added_rate.tobytes() == (base_rate + weight * rate).tobytes()
     for shape in ((3,), (16, 3), (4, 3)):
         v, heading = rng.normal(size=shape), rng.uniform(-4.0, 4.0)
         c, s = math.cos(heading), math.sin(heading)

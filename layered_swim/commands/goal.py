@@ -86,7 +86,8 @@ def _goal_policy(args) -> None:
     stroke, current = policy.env.stroke, vector(args.current, "--current")
     spec = _spec(args, stroke)
     result = evaluate_goals(policy, args.seeds, pool=args.pool, backend=args.backend,
-                            fluid_settings=spec.fluid_settings(), current_m_s=tuple(current))
+                            fluid_settings=spec.fluid_settings(), current_m_s=tuple(current),
+                            integrator=args.integrator)
     heuristic = goal_run(spec)
     result = {"policy": args.policy, "pool": args.pool, "stroke": stroke, "reference": policy.env.reference,
               "fluid_backend": args.backend, "current_m_s": list(current), "seeds": args.seeds, **result,

@@ -138,9 +138,7 @@ class LayeredController:
             rate = np.where(moving, running_rate, 0.0)
         for name, weight in self._blended_weights(time_s).items():
             if weight:
-                offset, offset_rate = self.stroke.perturbations[name].at(phase)
-                pose = pose + weight * offset
-                rate = rate + weight * offset_rate
+                pose, rate = self.stroke.perturbations[name].added(pose, rate, weight, phase)
         if state is not None:
             forward = forward_axis(state.quat("pelvis"), self.stroke.start.posture)   # read once a step
             self._track_attitude(state, forward)

@@ -206,6 +206,26 @@ class CyclicTable:
         i = min(int(x), TABLE_SAMPLES - 1)
         return _between_rows(self.values, self.rates, i, x - i)
 
+    def added(self, pose: np.ndarray, rate: np.ndarray, weight: float,
+              phase: float) -> tuple[np.ndarray, np.ndarray]:
+        """``pose + weight * value`` and ``rate + weight * its rate`` at ``phase`` (a weighted
+        perturbation on a pose), as new arrays."""
+        x = (phase % 1.0) * TABLE_SAMPLES
+        i = min(int(x), TABLE_SAMPLES - 1)
+        return _plus_between_rows(pose, rate, weight, self.values, self.rates, i, x - i)
+
+
+@njit(cache=True)
+def _plus_between_rows(pose, rate, weight, values, rates, i, w):
+    """``pose + weight * between`` (and the rates alike), ``between`` as ``_between_rows`` gives it:
+    numpy's operations in numpy's order, one element at a time."""
+    n = values.shape[1]
+    new_pose, new_rate = np.empty(n), np.empty(n)
+    for k in range(n):
+        new_pose[k] = pose[k] + weight * (values[i, k] * (1.0 - w) + values[i + 1, k] * w)
+        new_rate[k] = rate[k] + weight * (rates[i, k] * (1.0 - w) + rates[i + 1, k] * w)
+    return new_pose, new_rate
+
 
 @njit(cache=True)
 def _between_rows(values, rates, i, w):

@@ -1,15 +1,16 @@
 """The physics step without PyBullet: the same integration its multibody does, compiled.
 
 PyBullet's step of a floating multibody with no contacts is: the accelerations of the applied
-generalised forces, ``M qdd = Q - C``; the rates moved on by ``dt qdd``; each revolute joint
-at or beyond a limit pushed back by an impulse through the mass matrix (its joint-limit constraint:
-a row only while the limit is passed, whose rate is driven to ``erp`` of the excess a step,
-solved by projected Gauss-Seidel); then the positions moved on by the new rates (semi-implicit
-Euler), orientations by the exponential map. ``articulation`` already gives ``M`` and ``C`` (stable
-PD needs them), so a step here costs a Cholesky solve: a few microseconds against PyBullet's
-~15 plus its state reads and torque writes. From the same state it lands on PyBullet's next state
-to ~1e-14 (``tests/test_integrator.py``); over seconds the two drift apart as any two
-floating-point orders of the same sums do, without changing what the swimmer does.
+generalised forces, ``M qdd = Q - C``; the rates moved on by ``dt qdd``; each revolute joint at or
+past a limit pushed back by an impulse through the mass matrix (its joint-limit constraint: a row
+only while the limit is passed, whose rate is driven to ``erp`` of the excess a step, or only
+stopped past Bullet's split-impulse depth; projected Gauss-Seidel); then the positions moved on by
+the new rates (semi-implicit Euler), orientations by the exponential map. ``articulation`` already
+gives ``M`` and ``C`` (stable PD needs them), so a step here costs one factorisation of ``M`` (the
+tree's own, ``ltl_factor``) and a solve: a few microseconds against PyBullet's ~15 plus its state
+reads and torque writes. From the same state it lands on PyBullet's next state to rounding, and to
+~1e-6 where a joint sits on its limit (``tests/test_integrator.py``); over seconds the two drift
+apart as chaotic swims do, without changing how the swimmer swims.
 
 What it does not do: contacts (an SPH pool's walls), so a World with walls steps in PyBullet.
 """
@@ -20,8 +21,8 @@ import math
 import numpy as np
 from numba import njit
 
-from layered_swim.sim.articulation import SPHERICAL, forward_kinematics
-from layered_swim.sim.pd import cholesky_factor, cholesky_substitute, loads_and_pd
+from layered_swim.sim.articulation import SPHERICAL, forward_kinematics, ltl_factor, ltl_solve
+from layered_swim.sim.pd import loads_and_pd
 
 LIMIT_ERP = 0.2             # PyBullet's error reduction for joint limits (its default erp)
 LIMIT_ITERATIONS = 50       # its solver's iterations (numSolverIterations)
@@ -54,7 +55,7 @@ def _product_normalised(a, b, out):
 
 
 @njit(cache=True)
-def _push_back_limits(factor, q, qd, dt, limits, erp):
+def _push_back_limits(factor, parent, q, qd, dt, limits, erp):
     """Impulses on the joints past a limit (``limits`` rows: rate index, position index, lower,
     upper), each at least zero, that bring each one's rate to ``erp`` of its excess per step
     back inside; they act through the whole body's inverse mass matrix."""
@@ -81,7 +82,7 @@ def _push_back_limits(factor, q, qd, dt, limits, erp):
             wanted[k] = erp * excess / dt if excess < SPLIT_DEPTH else 0.0
             unit = np.zeros(qd.shape[0])
             unit[rate[k]] = 1.0
-            columns[k] = cholesky_substitute(factor, unit)
+            columns[k] = ltl_solve(factor, parent, unit)
             k += 1
     impulse = np.zeros(n_rows)
     for _ in range(LIMIT_ITERATIONS):
@@ -101,19 +102,20 @@ def _push_back_limits(factor, q, qd, dt, limits, erp):
 
 
 @njit(cache=True)
-def advance(index, mass, bias, load, q, qd, dt, limits, erp):
+def advance(index, parent, mass, bias, load, q, qd, dt, limits, erp):
     """One step on, in place: ``q``, ``qd`` the generalised positions and rates (``articulation.Tree``'s
     layout), ``mass`` and ``bias`` (used up) from ``articulation.mass_matrix_and_bias`` at this
-    state, ``load`` the generalised forces (the base's wrench, then the joints' torques)."""
+    state, ``load`` the generalised forces (the base's wrench, then the joints' torques);
+    ``parent`` from ``parent_rates``."""
     n = qd.shape[0]
     rhs = np.empty(n)
     for k in range(n):
         rhs[k] = load[k] - bias[k]
-    cholesky_factor(mass)
-    qdd = cholesky_substitute(mass, rhs)
+    ltl_factor(mass, parent)
+    qdd = ltl_solve(mass, parent, rhs)
     for k in range(n):
         qd[k] += dt * qdd[k]
-    _push_back_limits(mass, q, qd, dt, limits, erp)
+    _push_back_limits(mass, parent, q, qd, dt, limits, erp)
     turn = np.empty(4)
     for a in range(3):
         q[a] += dt * qd[3 + a]
@@ -129,13 +131,13 @@ def advance(index, mass, bias, load, q, qd, dt, limits, erp):
 
 
 @njit(cache=True)
-def drive_and_advance(index, params, frames, s, rows, force, torque, at, q, qd, target_q, target_qd, gains, dt,
+def drive_and_advance(index, parent, params, frames, s, rows, force, torque, at, q, qd, target_q, target_qd, gains, dt,
                       gravity_m_s2, base_wrench, tau, total, mass, bias, limits, erp):
     """A whole physics step in one call: the loads and stable PD (``pd.loads_and_pd``, its arguments
     and outputs), the step on (``advance``) and the new state's kinematics into ``frames`` and
     ``s`` (``articulation.forward_kinematics``)."""
     loads_and_pd(index, params, frames, s, rows, force, torque, at, q, qd, target_q, target_qd, gains, dt,
-                 gravity_m_s2, base_wrench, tau, total, mass, bias)
+                 gravity_m_s2, base_wrench, tau, total, mass, bias, parent)
     total[0:6] = base_wrench
-    advance(index, mass, bias, total, q, qd, dt, limits, erp)
+    advance(index, parent, mass, bias, total, q, qd, dt, limits, erp)
     forward_kinematics(index, params, q, qd, frames, s)

@@ -18,7 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
-from layered_swim.sim.articulation import SPHERICAL, generalized_forces, mass_matrix_and_bias
+from layered_swim.sim.articulation import SPHERICAL, generalized_forces, ltl_factor, ltl_solve, mass_matrix_and_bias
 
 
 @njit(cache=True)
@@ -85,12 +85,14 @@ def _ball_error(q, w_rel, dt, target, out):
 
 
 @njit(cache=True)
-def stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt):
+def stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt, parent):
     """Generalised forces (n_dof,), zero on the base's rates. ``mass`` and ``bias`` from
     ``mass_matrix_and_bias`` (``mass`` is used up: factorised in place); ``index`` the tree's
     (parent, kind, position index, rate index) table; ``q``, ``qd`` the generalised positions and
     rates, ``target_q``, ``target_qd`` laid out alike (their base entries unused); ``gains``
-    (3, n_dof): Kp, Kd and maximum torque per rate, zero on the base's."""
+    (3, n_dof): Kp, Kd and maximum torque per rate, zero on the base's. ``parent``
+    (``articulation.parent_rates``) solves with the tree's own factorisation; empty, with a dense
+    Cholesky (the bits every swim stepped by PyBullet has had)."""
     n = qd.shape[0]
     kp, kd, limit = gains[0], gains[1], gains[2]
     error = np.zeros(n)
@@ -104,8 +106,12 @@ def stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt):
     for k in range(n):
         mass[k, k] += dt * kd[k]
         rhs[k] = kp[k] * error[k] + kd[k] * (target_qd[k] - qd[k]) - bias[k]
-    cholesky_factor(mass)
-    qdd = cholesky_substitute(mass, rhs)
+    if parent.shape[0] > 0:
+        ltl_factor(mass, parent)
+        qdd = ltl_solve(mass, parent, rhs)
+    else:
+        cholesky_factor(mass)
+        qdd = cholesky_substitute(mass, rhs)
     tau = np.empty(n)
     for k in range(n):
         t = kp[k] * error[k] + kd[k] * (target_qd[k] - qd[k] - dt * qdd[k])
@@ -115,7 +121,7 @@ def stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt):
 
 @njit(cache=True)
 def loads_and_pd(index, params, frames, s, rows, force, torque, at, q, qd, target_q, target_qd, gains, dt,
-                 gravity_m_s2, base_wrench, tau, total, mass_out, bias_out):
+                 gravity_m_s2, base_wrench, tau, total, mass_out, bias_out, parent):
     """One call for a physics step's joint-space loads: the generalised forces of one wrench per
     body (``articulation.generalized_forces``), the stable PD torques (``stable_pd_torques`` on
     ``articulation.mass_matrix_and_bias``) and their sum on the joints' rates (zero on the base's,
@@ -129,7 +135,7 @@ def loads_and_pd(index, params, frames, s, rows, force, torque, at, q, qd, targe
     if mass_out.shape[0] > 0:       # stepping without PyBullet (``sim/integrator.py``) needs them after PD
         mass_out[:, :] = mass
         bias_out[:] = bias
-    tau[:] = stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt)
+    tau[:] = stable_pd_torques(mass, bias, index, q, qd, target_q, target_qd, gains, dt, parent)
     for k in range(tau.shape[0]):
         total[k] = (load[k] if k >= 6 else 0.0) + tau[k]
     base_wrench[:] = load[0:6]

@@ -46,6 +46,7 @@ from layered_swim.sim.articulation import (
     forward_kinematics,
     generalized_forces,
     mass_matrix_and_bias,
+    parent_rates,
 )
 from layered_swim.sim.integrator import LIMIT_ERP, advance, drive_and_advance
 from layered_swim.sim.pd import loads_and_pd, stable_pd_torques
@@ -199,12 +200,14 @@ class World:
         self._dynamics_fresh = False
         self._mass, self._bias = np.zeros((tree.n_dof, tree.n_dof)), np.zeros(tree.n_dof)
         self._no_mass, self._no_bias = np.zeros((0, 0)), np.zeros(0)     # stepped by PyBullet: not kept
+        self._no_parent = np.zeros(0, dtype=np.int64)     # stepped by PyBullet: stable PD's dense solve, its old bits
         limits = []
         for j in self._joints:
             info = c.getJointInfo(self.uid, j)
             if info[2] == pybullet.JOINT_REVOLUTE and info[8] <= info[9]:
                 limits.append((tree.rates_of(j + 1).start, tree.positions_of(j + 1).start, info[8], info[9]))
         self._limits = np.array(limits, dtype=np.float64).reshape(-1, 4)
+        self._parent_rates = parent_rates(tree.index)
         self._walls: list[int] = []                # static bodies of a pool the swimmer touches
 
     # --- state -------------------------------------------------------------------------
@@ -224,8 +227,7 @@ class World:
         self._fresh = False
         self._dynamics_fresh = False
         if self.own:      # from here on the World holds the coordinates itself
-            self._read_coordinates()
-            self._q, self._qd = self._q.copy(), self._qd.copy()
+            self._hold_coordinates()
 
     def set_pool(self, min_m, max_m, thickness_m: float = 0.1) -> None:
         """A floor and four walls on the faces of the box ``[min_m, max_m]`` that the swimmer
@@ -238,8 +240,7 @@ class World:
         touching = min_m is not None
         own = self.integrator == "own" and not touching
         if own and not self.own:        # on from PyBullet's state
-            self._read_coordinates()
-            self._q, self._qd = self._q.copy(), self._qd.copy()
+            self._hold_coordinates()
         elif self.own and not own:      # PyBullet on from ours
             self._write_coordinates()
         self.own, self._fresh = own, False
@@ -276,6 +277,18 @@ class World:
         flat = np.fromiter(chain(base_pos, base_quat, _flatten(map(_JOINT_POSITION, joints)), base_ang, base_lin,
                                  _flatten(map(_JOINT_RATE, joints))), np.float64, self._state_size)
         self._q, self._qd = flat[:tree.n_positions], flat[tree.n_positions:]
+
+    def _hold_coordinates(self) -> None:
+        """PyBullet's state as the World's own arrays, and the step's arguments around them (the
+        per-step call passes them as they are)."""
+        self._read_coordinates()
+        self._q, self._qd = self._q.copy(), self._qd.copy()
+        tree = self.tree
+        self._step_head = (tree.index, self._parent_rates, tree.params, self._frames, self._subspace,
+                           self._segment_rows)
+        self._step_tail = (self._q, self._qd, self._target_q, self._target_qd, self._gains, self.dt_s,
+                           self.gravity_m_s2, self._base_wrench, self._torque, self._total, self._mass, self._bias,
+                           self._limits, LIMIT_ERP)
 
     def _write_coordinates(self) -> None:
         uid, cid, q, qd = self.uid, self._cid, self._q, self._qd
@@ -346,8 +359,9 @@ class World:
         base, total = self._base_wrench, self._total
         loads_and_pd(tree.index, tree.params, self._frames, self._subspace, self._segment_rows, force_n, torque_nm,
                      at_m, self._q, self._qd, self._target_q, self._target_qd, self._gains, self.dt_s,
-                     self.gravity_m_s2, base, self._torque, total, *((self._mass, self._bias) if self.own else
-                                                                     (self._no_mass, self._no_bias)))
+                     self.gravity_m_s2, base, self._torque, total,
+                     *((self._mass, self._bias, self._parent_rates) if self.own else
+                       (self._no_mass, self._no_bias, self._no_parent)))
         if self.own:
             self._dynamics_fresh = True
             total[0:6] = base
@@ -367,11 +381,7 @@ class World:
             self.step()
             return
         self._ensure_fresh()
-        tree = self.tree
-        drive_and_advance(tree.index, tree.params, self._frames, self._subspace, self._segment_rows, force_n,
-                          torque_nm, at_m, self._q, self._qd, self._target_q, self._target_qd, self._gains, self.dt_s,
-                          self.gravity_m_s2, self._base_wrench, self._torque, self._total, self._mass, self._bias,
-                          self._limits, LIMIT_ERP)
+        drive_and_advance(*self._step_head, force_n, torque_nm, at_m, *self._step_tail)
         self.steps += 1
         self._fresh, self._dynamics_fresh = True, False
 
@@ -390,8 +400,8 @@ class World:
         if self.own:
             self._mass[:], self._bias[:] = mass, bias
             self._dynamics_fresh = True
-        self._torque = stable_pd_torques(mass, bias, tree.index, self._q, self._qd, self._target_q, self._target_qd,
-                                         self._gains, self.dt_s)
+        self._torque[:] = stable_pd_torques(mass, bias, tree.index, self._q, self._qd, self._target_q, self._target_qd,
+                                            self._gains, self.dt_s, self._parent_rates if self.own else self._no_parent)
         self._add_pending(self._torque)
 
     def _add_pending(self, generalised: np.ndarray) -> None:
@@ -419,7 +429,8 @@ class World:
             self._mass[:], self._bias[:] = mass_matrix_and_bias(tree.index, tree.params, self._frames, self._subspace,
                                                                 self.gravity_m_s2)
         load = self._pending if self._pending is not None else np.zeros(tree.n_dof)
-        advance(tree.index, self._mass, self._bias, load, self._q, self._qd, self.dt_s, self._limits, LIMIT_ERP)
+        advance(tree.index, self._parent_rates, self._mass, self._bias, load, self._q, self._qd, self.dt_s,
+                self._limits, LIMIT_ERP)
         self._pending = None
         self.steps += 1
         self._fresh = self._dynamics_fresh = False
