@@ -51,7 +51,7 @@ class BodyState:
     segments: Segments
     # The centre of mass, worked out on first asking (the controller, observation and reward each
     # ask it every control step); a state is a snapshot, its arrays never change after it is made.
-    _com_m: np.ndarray | None = field(default=None, repr=False, compare=False)
+    _com_m: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
 
     def pos(self, segment: str) -> np.ndarray:
         return self.pos_m[self.segments.rows[segment]]
