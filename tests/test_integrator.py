@@ -151,3 +151,18 @@ def _ancestors(parent, k):
         found.add(j)
         j = parent[j]
     return found
+
+
+def test_a_run_folder_from_before_the_own_integrator_replays_with_pybullet(tmp_path):
+    import json
+
+    from layered_swim.runs import repeatable, run_swim
+
+    spec = SwimSpec.of("test", stroke="front_crawl", seconds=0.2)
+    run_swim(spec, tmp_path / "run")
+    config = json.loads((tmp_path / "run" / "config.json").read_text())
+    assert config["swim"]["integrator"] == "own"
+    assert repeatable(tmp_path / "run" / "config.json")[1].integrator == "own"
+    del config["swim"]["integrator"]          # as written before the own integrator
+    (tmp_path / "old.json").write_text(json.dumps(config))
+    assert repeatable(tmp_path / "old.json")[1].integrator == "bullet"

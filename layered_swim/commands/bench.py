@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from layered_swim.commands.options import backend_option, fluid_settings
+from layered_swim.commands.options import backend_option, fluid_settings, integrator_option
 from layered_swim.commands.tables import fmt, table
 
 
@@ -21,6 +21,7 @@ def add_parser(subparsers) -> None:
                                                     "the training config's run.workers; 1: one core only)")
     bench.add_argument("--physics-hz", type=int, help="physics rate in Hz (default 480)")
     backend_option(bench)
+    integrator_option(bench)
 
 
 def run(args) -> None:

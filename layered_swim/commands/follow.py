@@ -8,6 +8,7 @@ from layered_swim.commands.export import export_option, export_swim, export_targ
 from layered_swim.commands.options import (
     backend_option,
     count,
+    integrator_option,
     medium,
     out_dir,
     overwrite_option,
@@ -39,6 +40,7 @@ def add_parser(subparsers) -> None:
     parallel_options(follow)
     ray_option(follow)
     backend_option(follow, pool="large")       # a trajectory's target starts 2 m ahead
+    integrator_option(follow)
 
 
 def run(args) -> None:

@@ -7,6 +7,7 @@ import json
 from layered_swim.commands.options import (
     backend_option,
     count,
+    integrator_option,
     medium,
     out_dir,
     overwrite_option,
@@ -34,6 +35,7 @@ def add_parser(subparsers) -> None:
                                      "default: no files)")
     overwrite_option(goal)
     backend_option(goal, pool=None)
+    integrator_option(goal)
 
 
 def run(args) -> None:

@@ -80,9 +80,6 @@ def backend_option(command: argparse.ArgumentParser, pool: str | None = "small")
     command.add_argument("--backend", default="plate",
                          help="fluid model: plate (thin plates + buoyancy, default) or sph (SPlisHSPlasH, "
                               "the [sph] extra)")
-    command.add_argument("--integrator", choices=("own", "bullet"), default="own",
-                         help="who steps the body: own (default: PyBullet's integration, compiled; docs/cli.md) "
-                              "or bullet (PyBullet's step)")
     sph = command.add_argument_group("SPH water (with --backend sph)")
     if pool:
         sph.add_argument("--pool", choices=("small", "large"), default=pool,
@@ -91,6 +88,12 @@ def backend_option(command: argparse.ArgumentParser, pool: str | None = "small")
     sph.add_argument("--particle-radius", type=float, default=0.025, metavar="M", help="default 0.025 m")
     sph.add_argument("--threads", type=count(1, 256), metavar="N", help="solver threads (default: every core)")
     sph.add_argument("--deterministic", action="store_true", help="one solver thread: bit-identical runs")
+
+
+def integrator_option(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--integrator", choices=("own", "bullet"), default="own",
+                         help="who steps the body: own (default: PyBullet's integration, compiled; docs/cli.md) "
+                              "or bullet (PyBullet's step)")
 
 
 def added_mass_option(command: argparse.ArgumentParser) -> None:

@@ -10,6 +10,7 @@ from layered_swim.commands.options import (
     added_mass_option,
     backend_option,
     flag,
+    integrator_option,
     medium,
     out_dir,
     overwrite_option,
@@ -42,6 +43,7 @@ def add_parser(subparsers) -> None:
     water_option(command)
     command.add_argument("--tempo", type=float, default=1.0, help="stroke rate multiplier (default 1)")
     backend_option(command)
+    integrator_option(command)
     added_mass_option(command)
     command.set_defaults(swim_defaults={name: command.get_default(name) for name in SWIM_OPTIONS})
 
