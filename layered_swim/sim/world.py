@@ -437,8 +437,9 @@ class World:
 
     def step_bullet(self) -> None:
         """PyBullet's own step of the body and nothing else: the floor ``bench`` measures against
-        (it moves PyBullet's copy of the body only; the World's state is not read back)."""
+        (stepping itself, the World's state stays where it was; a ``reset`` puts both together)."""
         pybullet.stepSimulation(physicsClientId=self._cid)
+        self._fresh = self._fresh and self.own
 
     def close(self) -> None:
         with contextlib.suppress(Exception):
