@@ -28,7 +28,7 @@ from layered_swim.episode import Episode
 from layered_swim.fluid.backend import FluidError
 from layered_swim.outputs import COMMAND_KEY, OutputFolder, atomic_path, claim, write_json
 from layered_swim.recorder import DEFAULT_LOG_HZ, SPOOL_DIR, Recorder
-from layered_swim.sim.simulation import SimulationDiverged
+from layered_swim.sim.simulation import DEFAULT_SIM, SimulationDiverged
 from layered_swim.spec import MIN_SECONDS, FollowTask, FreeSwimTask, GoalTask, SwimSpec
 from layered_swim.tasks import swim_benchmark as bench
 from layered_swim.tasks.goal import GOAL_METRICS
@@ -449,7 +449,7 @@ def bench_sph(seconds: float = 0.5, settings=None, stroke: str = "breaststroke")
 
 
 def bench_step(seconds: float = 5.0, physics_hz: int | None = None, stroke: str | None = None,
-               integrator: str = "own") -> dict:
+               integrator: str = DEFAULT_SIM.integrator) -> dict:
     """Microseconds per physics step: (a) the bare PyBullet step of the floating body (no fluid,
     no PD), (b) the whole loop (state read, fluid, wrenches, PD, step) through the episode runner.
     Each is timed BENCH_REPEATS times, alternating so that a burst of load elsewhere hits both, and

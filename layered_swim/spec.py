@@ -21,7 +21,7 @@ from layered_swim.episode import START_JITTER, WIDE_JITTER, Episode
 from layered_swim.fluid.flow_field import FlowField, WaterSpec
 from layered_swim.fluid.medium import Medium, water
 from layered_swim.recorder import DEFAULT_LOG_HZ
-from layered_swim.sim.simulation import PHYSICS_HZ
+from layered_swim.sim.simulation import DEFAULT_SIM, PHYSICS_HZ
 
 MAX_SECONDS = 24 * 3600.0     # a day: soak's longest; the log streams to disk, memory stays flat
 MIN_SECONDS = 0.1             # a few log samples, so the metrics have a time span
@@ -76,7 +76,7 @@ class SwimSpec(Strict):
     sph: dict | None = None                     # the SPH settings' fields (backend sph)
     plate: dict | None = None                   # the thin plates' settings' fields (backend plate), e.g. added_mass
     physics_hz: int = Field(PHYSICS_HZ, ge=120, le=5000)
-    integrator: Literal["own", "bullet"] = "own"    # who steps the body (sim/integrator.py): ours, or PyBullet
+    integrator: Literal["own", "bullet"] = DEFAULT_SIM.integrator    # who steps the body: ours, or PyBullet
     log_hz: int = Field(DEFAULT_LOG_HZ, ge=1, le=5000)
     tempo: between(0.1, 5.0) = 1.0
     lung_air_l: between(0.0, 8.0) | None = None

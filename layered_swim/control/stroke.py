@@ -202,41 +202,49 @@ class CyclicTable:
     rates: np.ndarray
 
     def at(self, phase: float) -> tuple[np.ndarray, np.ndarray]:
-        x = (phase % 1.0) * TABLE_SAMPLES
-        i = min(int(x), TABLE_SAMPLES - 1)
-        return _between_rows(self.values, self.rates, i, x - i)
+        return _between_rows(self.values, self.rates, *_place(phase))
 
     def added(self, pose: np.ndarray, rate: np.ndarray, weight: float,
               phase: float) -> tuple[np.ndarray, np.ndarray]:
         """``pose + weight * value`` and ``rate + weight * its rate`` at ``phase`` (a weighted
         perturbation on a pose), as new arrays."""
-        x = (phase % 1.0) * TABLE_SAMPLES
-        i = min(int(x), TABLE_SAMPLES - 1)
-        return _plus_between_rows(pose, rate, weight, self.values, self.rates, i, x - i)
+        return _plus_between_rows(pose, rate, weight, self.values, self.rates, *_place(phase))
 
 
-@njit(cache=True)
-def _plus_between_rows(pose, rate, weight, values, rates, i, w):
-    """``pose + weight * between`` (and the rates alike), ``between`` as ``_between_rows`` gives it:
-    numpy's operations in numpy's order, one element at a time."""
-    n = values.shape[1]
-    new_pose, new_rate = np.empty(n), np.empty(n)
-    for k in range(n):
-        new_pose[k] = pose[k] + weight * (values[i, k] * (1.0 - w) + values[i + 1, k] * w)
-        new_rate[k] = rate[k] + weight * (rates[i, k] * (1.0 - w) + rates[i + 1, k] * w)
-    return new_pose, new_rate
+def _place(phase: float) -> tuple[int, float]:
+    """The table row at or before ``phase`` (in cycles, any real number) and how far on to the next."""
+    x = (phase % 1.0) * TABLE_SAMPLES
+    i = min(int(x), TABLE_SAMPLES - 1)
+    return i, x - i
+
+
+@njit(cache=True, inline="always")
+def _mixed(table, i, k, w):
+    """Column k of rows i and i + 1 mixed by ``w``: numpy's ``a * (1 - w) + b * w``, the same bits."""
+    return table[i, k] * (1.0 - w) + table[i + 1, k] * w
 
 
 @njit(cache=True)
 def _between_rows(values, rates, i, w):
-    """Rows i and i + 1 of both tables mixed by ``w``: numpy's ``a * (1 - w) + b * w`` element by
-    element, the same bits (the controller asks it several times a control step)."""
+    """Rows i and i + 1 of both tables mixed by ``w``, element by element (the controller asks it
+    several times a control step)."""
     n = values.shape[1]
     pose, rate = np.empty(n), np.empty(n)
     for k in range(n):
-        pose[k] = values[i, k] * (1.0 - w) + values[i + 1, k] * w
-        rate[k] = rates[i, k] * (1.0 - w) + rates[i + 1, k] * w
+        pose[k] = _mixed(values, i, k, w)
+        rate[k] = _mixed(rates, i, k, w)
     return pose, rate
+
+
+@njit(cache=True)
+def _plus_between_rows(pose, rate, weight, values, rates, i, w):
+    """``pose + weight * between`` (and the rates alike), ``between`` as ``_between_rows`` gives it."""
+    n = values.shape[1]
+    new_pose, new_rate = np.empty(n), np.empty(n)
+    for k in range(n):
+        new_pose[k] = pose[k] + weight * _mixed(values, i, k, w)
+        new_rate[k] = rate[k] + weight * _mixed(rates, i, k, w)
+    return new_pose, new_rate
 
 
 @dataclass(frozen=True)

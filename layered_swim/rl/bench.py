@@ -13,10 +13,11 @@ import torch
 
 from layered_swim.rl.ppo import ActorCritic, ActorSnapshot, Normaliser
 from layered_swim.rl.rollouts import make_env
+from layered_swim.sim.simulation import DEFAULT_SIM
 
 
 def bench_env(seconds: float = 10.0, env_state: str = "SmoothFT", hidden: tuple[int, ...] = (256, 256),
-              workers: int | None = None, integrator: str = "own") -> dict:
+              workers: int | None = None, integrator: str = DEFAULT_SIM.integrator) -> dict:
     """Environment steps over about ``seconds`` of simulated time with a fresh policy, one thread;
     then ``workers`` processes (default: the shipped training config's ``run.workers``) doing the
     same at once, each on its own core as the trainer's rollout workers run: the steps per second

@@ -36,7 +36,7 @@ from layered_swim.rl import observation as obs
 from layered_swim.rl.config import DrawsSpec, RewardSpec
 from layered_swim.rl.reward import BODY_POINT_WEIGHTS, reward_parts
 from layered_swim.runs import goal_episode
-from layered_swim.sim.simulation import SimulationDiverged
+from layered_swim.sim.simulation import DEFAULT_SIM, SimulationDiverged
 from layered_swim.spec import SwimSpec, sph_fields
 from layered_swim.state import BodyState
 from layered_swim.tasks import swim_benchmark as bench
@@ -125,7 +125,7 @@ class SwimGoalEnv(gym.Env):
                  reward_weights: RewardSpec | dict = RewardSpec(), backend: str = "plate", fluid_settings=None,
                  current_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0), goal: int | None = None,
                  start_jitter: bool = False, density_kg_m3: float | None = None,
-                 draws: DrawsSpec | dict | None = None, integrator: str = "own"):
+                 draws: DrawsSpec | dict | None = None, integrator: str = DEFAULT_SIM.integrator):
         if isinstance(reward_weights, dict):     # gym.make's keyword arguments: checked like the YAML's reward section
             reward_weights = parse(RewardSpec, reward_weights, "the environment's reward_weights")
         if isinstance(draws, dict):

@@ -21,6 +21,7 @@ import math
 import numpy as np
 from numba import njit
 
+from layered_swim.geometry import quat_product_into
 from layered_swim.sim.articulation import SPHERICAL, forward_kinematics, ltl_factor, ltl_solve
 from layered_swim.sim.pd import loads_and_pd
 
@@ -45,13 +46,12 @@ def _turn(omega0, omega1, omega2, dt, out):
 
 
 @njit(cache=True, inline="always")
-def _product_normalised(a, b, out):
-    x = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1]
-    y = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0]
-    z = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3]
-    w = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2]
-    norm = math.sqrt(x * x + y * y + z * z + w * w)
-    out[0], out[1], out[2], out[3] = x / norm, y / norm, z / norm, w / norm
+def _turned_by(a, b, out):
+    """out = a * b (``geometry.quat_product_into``), scaled back to unit length."""
+    quat_product_into(a, b, out)
+    norm = math.sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2] + out[3] * out[3])
+    for k in range(4):
+        out[k] = out[k] / norm
 
 
 @njit(cache=True)
@@ -120,12 +120,12 @@ def advance(index, parent, mass, bias, load, q, qd, dt, limits, erp):
     for a in range(3):
         q[a] += dt * qd[3 + a]
     _turn(qd[0], qd[1], qd[2], dt, turn)     # the base's rate is its world angular velocity: turned first
-    _product_normalised(turn, q[3:7].copy(), q[3:7])
+    _turned_by(turn, q[3:7].copy(), q[3:7])
     for i in range(1, index.shape[0]):
         qa, da = index[i, 2], index[i, 3]
         if index[i, 1] == SPHERICAL:          # the child's rate in its own frame: turned last
             _turn(qd[da], qd[da + 1], qd[da + 2], dt, turn)
-            _product_normalised(q[qa:qa + 4].copy(), turn, q[qa:qa + 4])
+            _turned_by(q[qa:qa + 4].copy(), turn, q[qa:qa + 4])
         else:
             q[qa] += dt * qd[da]
 
