@@ -496,6 +496,19 @@ def test_a_swimmer_ahead_of_its_target_but_far_off_its_path_swims_back_instead_o
     assert off.thrust_demand > 0.0 and off.tempo > TempoControl().min_tempo
 
 
+
+def test_a_swimmer_ahead_of_a_diving_target_but_above_it_dives_on_instead_of_waiting():
+    """With ``wait_depth_within_m`` a swimmer ahead of its target waits only near the depth it
+    steers for: 1.5 m above it (the breaststroke rode up nose-first at its slowest tempo and lost
+    the deep dive) it swims on down."""
+    lead = Lead(wait_depth_within_m=0.5)
+    assert lead.waits(2.0, 0.5, 0.4) and not lead.waits(2.0, 0.5, 0.6) and Lead().waits(2.0, 0.5, 5.0)
+    deep = TrajectoryTarget(np.array([[-2.0, 0.0, -1.5], [20.0, 0.0, -1.5]]), np.array([0.0, 22.0]), 0.5, False)
+    state = still_state(np.full(16, 1 / 16))          # at the origin, 2 m (4 s) ahead of the target
+    assert TargetChooser(deep, table(), "prone")(0, state, None).thrust_demand == 0.0
+    diving = TargetChooser(deep, table(), "prone", lead=Lead(wait_depth_within_m=0.5))(0, state, None)
+    assert diving.thrust_demand > 0.0 and diving.tempo > TempoControl().min_tempo
+
 def test_drift_is_the_sideways_motion_over_a_cycle_and_a_steady_turn_has_none():
     drift = Drift()
     for k in range(8):          # heading +x at 1 m/s, carried toward -y at 0.3 m/s

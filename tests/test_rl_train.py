@@ -258,6 +258,21 @@ def test_a_training_starts_from_a_policy_of_the_same_shape(tmp_path):
         load_train_spec(None, ["run.start_from=nowhere.pt"])
 
 
+
+def test_a_start_typed_with_set_is_read_from_the_working_folder(tmp_path, monkeypatch):
+    (tmp_path / "a").mkdir()
+    (tmp_path / "a" / "policy.pt").write_bytes(b"")
+    (tmp_path / "configs").mkdir()
+    config = tmp_path / "configs" / "stage.yaml"
+    config.write_text("run:\n  start_from: ../a/policy.pt\n")
+    monkeypatch.chdir(tmp_path)
+    expected = str((tmp_path / "a" / "policy.pt").resolve())
+    assert load_train_spec(config, TINY).run.start_from == expected
+    assert load_train_spec(config, TINY + ["run.start_from=a/policy.pt"]).run.start_from == expected
+    with pytest.raises(ConfigError, match="--set run.start_from: no policy file"):
+        load_train_spec(config, ["run.start_from=../a/policy.pt"])
+
+
 def test_a_policy_file_from_before_draws_loads_as_trained_without_them():
     from layered_swim.analysis.experiments.swim_table import POLICIES
 
@@ -265,3 +280,13 @@ def test_a_policy_file_from_before_draws_loads_as_trained_without_them():
     assert quiet.env.draws is None and quiet.env.pool == "small"
     shipped = ResidualPolicy.load(POLICIES / "front_crawl_layered.pt")
     assert shipped.env.reference == "layered" and shipped.env.draws.pools == ("small", "large")
+
+
+@pytest.mark.parametrize("name", ["front_crawl.yaml", "front_crawl_anywhere.yaml", "front_crawl_steady.yaml"])
+def test_each_shipped_training_file_loads_and_starts_from_a_shipped_policy(name):
+    from layered_swim.rl.config import SHIPPED_CONFIG
+
+    spec = load_train_spec(SHIPPED_CONFIG.parent / name)
+    if spec.run.start_from is not None:
+        policy = ResidualPolicy.load(spec.run.start_from)
+        assert policy.env.stroke == spec.env.stroke == "front_crawl"

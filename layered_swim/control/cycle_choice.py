@@ -100,6 +100,9 @@ class Lead:
     # corner), "ahead" is its nearest point on the path, and waiting there let the water carry it
     # on (the crawl ended 15-35 m off a square in a 0.3 m/s cross current). There it swims back.
     wait_within_m: float = 1.0
+    # ... and within this of the depth it steers for (waiting at its slowest tempo, the breaststroke
+    # rose nose-up from 1.5 m above a diving path it was ahead on, and lost the dive).
+    wait_depth_within_m: float = math.inf
     # A stroke that glides near its target (``TempoControl.glide_within_m``) glides only when this
     # far ahead of it along its path: gliding as soon as near, the crawl glided while still behind
     # and trailed its target by about the glide distance (figure-eight 0.76 m; this alone 0.66 m).
@@ -127,9 +130,11 @@ class Lead:
         from_s = max(time_s, place_s)
         return target.position(from_s + self.seconds(target, from_s)), place_s - time_s, off_path_m
 
-    def waits(self, ahead_of_target_s: float, off_path_m: float) -> bool:
-        """Whether to wait for the target: well ahead of it along its path, and on the path."""
-        return ahead_of_target_s > self.wait_ahead_s and off_path_m <= self.wait_within_m
+    def waits(self, ahead_of_target_s: float, off_path_m: float, depth_off_m: float = 0.0) -> bool:
+        """Whether to wait for the target: well ahead of it along its path, and on the path, at
+        the depth it steers for (``depth_off_m`` from it)."""
+        return (ahead_of_target_s > self.wait_ahead_s and off_path_m <= self.wait_within_m
+                and depth_off_m <= self.wait_depth_within_m)
 
     def seconds(self, target: Target, time_s: float) -> float:
         now, later = _step_m(target, time_s), _step_m(target, time_s + self.bend_s)
@@ -235,7 +240,7 @@ class TargetChooser:
         # instead carried the breaststroke further out of the figure-eight), gliding where the stroke
         # glides to wait (gliding, the breaststroke's depth drifted 0.27 m off a diving target's);
         # far off the path it swims back instead.
-        waiting = self.lead.waits(ahead_of_target_s, off_path_m)
+        waiting = self.lead.waits(ahead_of_target_s, off_path_m, abs(float(target[2] - position[2])))
         drive = 0.0 if waiting else self.tempo_control.drive(distance, heading_error)
         # Levelling off, kick at the level-off tempo even for a target behind: a fast kick lies it down sooner.
         tempo = self.level_off_tempo if self._levelling else self.tempo_control.tempo_for(drive)

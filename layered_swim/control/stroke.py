@@ -123,6 +123,9 @@ class SteeringSpec(Strict):
     # ... and only within this of the path (farther off, swim back to it; a stroke that follows
     # loosely waits from farther).
     wait_within_m: float = Field(1.0, gt=0.0, le=100.0)
+    # ... and only within this of the depth it steers for (none: at any depth): a stroke that rides
+    # up at its slowest tempo (the breaststroke) dives on instead of waiting above a diving path.
+    wait_depth_within_m: float | None = Field(None, gt=0.0, le=10.0)
     # Steer upstream of the aim by the sideways drift measured over the last cycles (a current
     # across the path); the goal task's swims, which the shipped residuals learnt on, never do.
     aim_off: bool = False

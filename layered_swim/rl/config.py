@@ -192,8 +192,12 @@ def load_train_spec(path: str | Path | None, overrides: list[str] = ()) -> Train
             raise ConfigError(f"--set {key}: cannot read the value {text!r}") from None
     spec = parse(TrainSpec, data, f"{source}{' with --set' if overrides else ''}")
     if spec.run.start_from is not None:
-        start = source.parent / spec.run.start_from     # an absolute start_from stays as it is
+        # A file's path is read from the file's folder, one typed with --set from the working folder;
+        # an absolute one stays as it is.
+        typed = any(item.partition("=")[0] == "run.start_from" for item in overrides)
+        start = (Path.cwd() if typed else source.parent) / spec.run.start_from
         if not start.is_file():
-            raise ConfigError(f"{source}: run.start_from: no policy file {start}")
+            where = "--set run.start_from" if typed else f"{source}: run.start_from"
+            raise ConfigError(f"{where}: no policy file {start}")
         spec = spec.model_copy(update={"run": spec.run.model_copy(update={"start_from": str(start.resolve())})})
     return spec
