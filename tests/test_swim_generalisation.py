@@ -132,3 +132,12 @@ def test_one_real_swim_of_each_controller_in_the_training_condition():
     assert results["residual"]["runs"][0]["pos_m"] == expected["pos_m"]
     dense = sg.run({**next(c for c in quiet if c["controller"] == "residual"), "density_kg_m3": 1500.0})
     assert np.isfinite(dense["runs"][0]["pos_m"]) and dense["runs"][0]["pos_m"] != expected["pos_m"]
+
+
+def test_the_experiment_says_it_wrote_all_four_figures(tmp_path, monkeypatch):
+    from layered_swim.analysis.experiments.runner import run_experiment
+
+    monkeypatch.setattr(sg, "run", made_up)         # one worker runs the sweep here, not in a process
+    result = run_experiment(sg, tmp_path / "out", quick=True, workers=1)
+    assert result["files"][:4] == [sg.FIGURE, *sg.FIGURES.values()]
+    assert all((tmp_path / "out" / name).is_file() for name in result["files"])

@@ -64,7 +64,8 @@ def run_experiment(module, out_dir: OutputFolder | str | Path, quick: bool = Fal
     write_json(out / "summary.json", summary)
     write_text(out / "report.md", report.experiment_report(module.TITLE, module.FIGURE, module.CSV, module.PAPER,
                                                            outcome.ours, outcome.setting, outcome.differs))
-    return {**summary, "files": [module.FIGURE, module.CSV, "summary.json", "config.json", "report.md"]}
+    figures = summary.get("figures", [module.FIGURE])      # an experiment may draw more than one
+    return {**summary, "files": [*figures, module.CSV, "summary.json", "config.json", "report.md"]}
 
 
 def episode_fluid(config: dict) -> dict:
