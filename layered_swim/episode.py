@@ -234,9 +234,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                     turn_tempo_until_ahead_s=steer.turn_tempo_until_ahead_s,
                                     wide_turn_rad=math.radians(steer.wide_turn_deg))
                 lead = Lead(bend_s=steer.lead_bend_s, wait_ahead_s=steer.wait_ahead_s,
-                            wait_within_m=steer.wait_within_m, aim_off=steer.aim_off,
-                            wait_depth_within_m=(math.inf if steer.wait_depth_within_m is None
-                                                 else steer.wait_depth_within_m))
+                            wait_within_m=steer.wait_within_m, wait_depth_within_m=steer.wait_depth_within_m,
+                            aim_off=steer.aim_off)
             gains = SteeringGains(steer.yaw_fraction, *pitch_roll,
                                   over_weight_within_rad=math.radians(steer.over_weight_within_deg),
                                   depth_within_m=steer.depth_within_m,

@@ -100,9 +100,9 @@ class Lead:
     # corner), "ahead" is its nearest point on the path, and waiting there let the water carry it
     # on (the crawl ended 15-35 m off a square in a 0.3 m/s cross current). There it swims back.
     wait_within_m: float = 1.0
-    # ... and within this of the depth it steers for (waiting at its slowest tempo, the breaststroke
-    # rose nose-up from 1.5 m above a diving path it was ahead on, and lost the dive).
-    wait_depth_within_m: float = math.inf
+    # ... and within this of the depth it steers for (None: at any depth; waiting at its slowest
+    # tempo, the breaststroke rose nose-up from 1.5 m above a diving path it was ahead on, and lost the dive).
+    wait_depth_within_m: float | None = None
     # A stroke that glides near its target (``TempoControl.glide_within_m``) glides only when this
     # far ahead of it along its path: gliding as soon as near, the crawl glided while still behind
     # and trailed its target by about the glide distance (figure-eight 0.76 m; this alone 0.66 m).
@@ -134,7 +134,7 @@ class Lead:
         """Whether to wait for the target: well ahead of it along its path, and on the path, at
         the depth it steers for (``depth_off_m`` from it)."""
         return (ahead_of_target_s > self.wait_ahead_s and off_path_m <= self.wait_within_m
-                and depth_off_m <= self.wait_depth_within_m)
+                and (self.wait_depth_within_m is None or depth_off_m <= self.wait_depth_within_m))
 
     def seconds(self, target: Target, time_s: float) -> float:
         now, later = _step_m(target, time_s), _step_m(target, time_s + self.bend_s)

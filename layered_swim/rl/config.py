@@ -177,8 +177,10 @@ def load_train_spec(path: str | Path | None, overrides: list[str] = ()) -> Train
     data = load_yaml(source) or {}
     if not isinstance(data, dict):
         raise ConfigError(f"{source}: expected a mapping at the top level, got {type(data).__name__}")
+    typed = False           # run.start_from given with --set
     for item in overrides:
         key, sep, text = item.partition("=")
+        typed = typed or key == "run.start_from"
         if not sep or not key:
             raise ConfigError(f"--set expects key=value, got {item!r}")
         parts, node = key.split("."), data
@@ -194,7 +196,6 @@ def load_train_spec(path: str | Path | None, overrides: list[str] = ()) -> Train
     if spec.run.start_from is not None:
         # A file's path is read from the file's folder, one typed with --set from the working folder;
         # an absolute one stays as it is.
-        typed = any(item.partition("=")[0] == "run.start_from" for item in overrides)
         start = (Path.cwd() if typed else source.parent) / spec.run.start_from
         if not start.is_file():
             where = "--set run.start_from" if typed else f"{source}: run.start_from"
