@@ -38,7 +38,7 @@ from layered_swim.config import ConfigError, load
 from layered_swim.control.auto import AUTO, AUTO_STROKES, AutoStrokeController
 from layered_swim.control.basic import StrokeController
 from layered_swim.control.calibration import load_table
-from layered_swim.control.cycle_choice import Lead, TargetChooser, TempoControl
+from layered_swim.control.cycle_choice import Lead, TargetChooser, TempoControl, Water
 from layered_swim.control.layered import CycleChooser, LayeredController, Layers, fixed_weights
 from layered_swim.control.lungs import LungControl
 from layered_swim.control.rules import arm_indices
@@ -109,13 +109,15 @@ class Episode:
 
     def _build_controller(self, stroke, strokes, layout, layers, weights, tempo, tempo_control, fluid):
         if stroke != AUTO:
-            return _controller(self.stroke, self.body, layout, self.task.target, layers, weights, tempo, tempo_control)
+            return _controller(self.stroke, self.body, layout, self.task.target, layers, weights, tempo, tempo_control,
+                               lambda: fluid.medium)
         if self.task.target is None or weights is not None or not layers.cycle:
             raise ConfigError("--stroke auto chooses strokes to chase a target: it needs one (follow, goal, "
                               "the app) and the per-cycle layer")
         # auto weighs what the target asks against the water swum in (the app may change it).
         return AutoStrokeController(
-            {name: _controller(s, self.body, layout, self.task.target, layers, None, tempo, tempo_control)
+            {name: _controller(s, self.body, layout, self.task.target, layers, None, tempo, tempo_control,
+                               lambda: fluid.medium)
              for name, s in strokes.items()}, self.task.target,
             medium=lambda: fluid.medium)
 
@@ -217,7 +219,7 @@ def jittered_start(start: Start, rng: np.random.Generator, jitter: StartJitter =
 
 
 def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Layers, weights: CycleChooser | None,
-                tempo: float, tempo_control: TempoControl | None):
+                tempo: float, tempo_control: TempoControl | None, water: Callable[[], Water]):
     if weights is None and target is None:
         return StrokeController(stroke, tempo)
     goal_line = tempo_control is not None
@@ -244,7 +246,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
             level_off = (math.radians(steer.level_off_beyond_deg)
                          if LEVEL_OFF in stroke.perturbations and lying(stroke.start.posture) else None)
             weights = TargetChooser(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,
-                                    lead=lead, level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo)
+                                    lead=lead, level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo,
+                                    water=None if goal_line else water)
         else:
             weights = fixed_weights({}, tempo=tempo)
     lungs = (LungControl(body.lung_air_l, body.max_lung_air_l, breathe_out=stroke.steering.breathe_out)

@@ -63,6 +63,11 @@ def test_flows_add_and_a_medium_adds_its_current():
     medium = water(current_m_s=(0.0, 0.1, 0.0), flow=field(uniform))
     np.testing.assert_allclose(medium.current_at(points, 0.0), [[0.2, 0.1, 0.0]] * 2)
     np.testing.assert_allclose(water(current_m_s=(0.3, 0, 0)).current_at(points, 0.0), [[0.3, 0, 0]] * 2)
+    # The steady part (what steering reads) leaves a wave's circling water out.
+    wave = {"type": "wave", "amplitude_m": 0.1, "wavelength_m": 2 * math.pi}
+    swell = water(current_m_s=(0.0, 0.1, 0.0), flow=field(uniform, wave))
+    assert np.abs(swell.current_at(points, 0.0) - [[0.2, 0.1, 0.0]]).max() > 0.05
+    np.testing.assert_allclose(swell.current_at(points, 0.0, waves=False), [[0.2, 0.1, 0.0]] * 2)
 
 
 def _state(pos_m) -> BodyState:

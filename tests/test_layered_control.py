@@ -9,7 +9,7 @@ from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, load
 from layered_swim.control.calibration import CalibrationTable, Pace, load_table
-from layered_swim.control.cycle_choice import Drift, Lead, TargetChooser, TempoControl
+from layered_swim.control.cycle_choice import Drift, InWater, Lead, TargetChooser, TempoControl
 from layered_swim.control.layered import CycleChoice, LayeredController, Layers, fixed_weights
 from layered_swim.control.rules import arm_indices, rule_offsets
 from layered_swim.control.steering import (
@@ -510,14 +510,16 @@ def test_a_swimmer_ahead_of_a_diving_target_but_above_it_dives_on_instead_of_wai
     assert diving.thrust_demand > 0.0 and diving.tempo > TempoControl().min_tempo
 
 def test_drift_is_the_sideways_motion_over_a_cycle_and_a_steady_turn_has_none():
-    drift = Drift()
+    drift, known = Drift(), Drift()
     for k in range(8):          # heading +x at 1 m/s, carried toward -y at 0.3 m/s
-        drift.update(1.5 * k, np.array([1.5 * k, -0.45 * k, -0.3]), 0.0)
+        drift.update(1.5 * k, np.array([1.5 * k, -0.45 * k, -0.3]), 0.0, np.zeros(3))
+        known.update(1.5 * k, np.array([1.5 * k, -0.45 * k, -0.3]), 0.0, np.array([0.0, -0.2, 0.0]))
     assert drift.m_s == pytest.approx([0.0, -0.3], abs=0.01)
+    assert known.m_s == pytest.approx([0.0, -0.1], abs=0.01)       # what the known current does not explain
     turning = Drift()
     for k in range(8):          # a steady 2 m circle, heading along the track
         angle = 0.5 * k
-        turning.update(float(k), np.array([2 * math.sin(angle), 2 - 2 * math.cos(angle), 0.0]), angle)
+        turning.update(float(k), np.array([2 * math.sin(angle), 2 - 2 * math.cos(angle), 0.0]), angle, np.zeros(3))
     assert np.abs(turning.m_s).max() < 1e-9
     # Aimed off upstream by what the drift beyond its dead zone carries it while it swims there (3 s),
     # at most half the way; a drift within the dead zone (a stroke's own turns) changes nothing.
@@ -528,6 +530,41 @@ def test_drift_is_the_sideways_motion_over_a_cycle_and_a_steady_turn_has_none():
     strong = Drift()
     strong.m_s = np.array([0.0, -2.0])
     assert strong.aimed_off(np.zeros(3), np.array([3.0, 0.0, -0.3]), 1.0) == pytest.approx([3.0, 1.5, -0.3])
+
+
+class UniformWater:
+    surface_z_m = 0.0
+
+    def __init__(self, current_m_s):
+        self.current_m_s = np.asarray(current_m_s, float)
+
+    def current_at(self, points_m, time_s, waves=True):
+        return np.tile(self.current_m_s, (len(np.atleast_2d(points_m)), 1))
+
+
+def test_a_known_current_is_steered_for_in_the_waters_frame():
+    """A target on a line along +x at 0.5 m/s, the swimmer on it. Water flowing toward -y at 0.3 m/s
+    moves the aim (1.5 s ahead) upstream by the 0.45 m the water carries the swimmer meanwhile: it
+    turns into the current before any drift shows. Water flowing against the target asks the
+    target's pace plus the current's (0.8 m/s: full tempo) where still water asks 0.5 m/s (0.625),
+    and water across it asks their sum as vectors (0.58 m/s: 0.729)."""
+    line = TrajectoryTarget(np.array([[0.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 20.0]), 0.5, False)
+    seen = InWater(line, np.array([0.0, -0.3, 0.0]), 2.0)
+    assert seen.position(2.0) == pytest.approx(line.position(2.0))
+    assert seen.position(4.0) == pytest.approx(line.position(4.0) + [0.0, 0.6, 0.0])
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
+
+    def choice(current_m_s):
+        water = UniformWater(current_m_s)
+        return TargetChooser(line, table(), "prone", water=lambda: water)(0, state, None)
+
+    still, across, against = choice((0.0, 0.0, 0.0)), choice((0.0, -0.3, 0.0)), choice((-0.3, 0.0, 0.0))
+    assert still.weights.get("yaw_left", 0.0) == 0.0 and still.tempo == pytest.approx(0.625)
+    # The aim at (0.75, 0.45): 31 deg to the left, turned by its share this cycle (the table's 8 deg at most).
+    assert across.weights["yaw_left"] > 0.0
+    assert across.tempo == pytest.approx(0.5 + 0.5 * (math.hypot(0.5, 0.3) - 0.4) / 0.4)
+    assert against.weights.get("yaw_left", 0.0) == 0.0 and against.tempo == pytest.approx(1.0)
+    assert TargetChooser(line, table(), "prone")(0, state, None) == still       # no water to read: still water
 
 
 def test_a_gliding_stroke_near_its_target_glides_only_once_ahead_of_it_along_its_path():

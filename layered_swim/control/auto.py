@@ -29,10 +29,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable, NamedTuple, Protocol
+from typing import Callable, NamedTuple
 
 import numpy as np
 
+from layered_swim.control.cycle_choice import Water
 from layered_swim.control.layered import LayeredController
 from layered_swim.control.steering import attitude_of, bearing_error
 from layered_swim.control.targets import Target, target_speed_m_s, target_velocity_m_s
@@ -115,14 +116,6 @@ class StrokeChoice:
         if fast:
             return max(fast, key=lambda name: others[name].turn_rad_per_m)
         return max(others, key=lambda name: others[name].top_m_s)
-
-
-class Water(Protocol):
-    """What ``auto`` reads of the water swum in (a ``fluid.medium.Medium``)."""
-
-    surface_z_m: float
-
-    def current_at(self, points_m: np.ndarray, time_s: float) -> np.ndarray: ...
 
 
 class Switch(NamedTuple):
@@ -218,7 +211,7 @@ class AutoStrokeController:
         velocity = target_velocity_m_s(self.target, time_s)
         if np.linalg.norm(velocity) > self.choice_rule.jumped_beyond_m_s:
             velocity = np.zeros(3)
-        velocity = velocity - self.medium().current_at(position_m, time_s)[0]
+        velocity = velocity - self.medium().current_at(position_m, time_s, waves=False)[0]
         return float(np.hypot(velocity[0], velocity[1]))
 
     def _hold_changes_now(self, state: BodyState) -> bool:

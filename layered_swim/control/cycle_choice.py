@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable, Protocol
 
 import numpy as np
 
@@ -79,6 +80,31 @@ class TempoControl:
 
 
 STEP_S = 0.5    # the target's direction and speed are read from its move over this long
+
+
+class Water(Protocol):
+    """What a swimmer reads of the water swum in (a ``fluid.medium.Medium``)."""
+
+    surface_z_m: float
+
+    def current_at(self, points_m: np.ndarray, time_s: float, waves: bool = True) -> np.ndarray: ...
+
+
+class InWater:
+    """``target`` as seen from water moving at ``current_m_s`` from ``now_s`` on: its path less the
+    water's move since ``now_s`` (a Galilean change of frame, exact for a uniform current). Steered
+    in this frame, a swimmer crabs across a current by as much as it carries it, before any drift
+    shows, and keeps a target's pace through the water, not over the ground."""
+
+    def __init__(self, target: Target, current_m_s: np.ndarray, now_s: float):
+        self.target, self.current_m_s, self.now_s = target, current_m_s, now_s
+        self.foresight = getattr(target, "foresight", True)
+
+    def position(self, time_s: float) -> np.ndarray:
+        return self.target.position(time_s) - self.current_m_s * (time_s - self.now_s)
+
+    def path_points(self, n: int = 400) -> np.ndarray:
+        return self.target.path_points(n)
 
 
 def _step_m(target: Target, time_s: float) -> np.ndarray:
@@ -164,12 +190,14 @@ class Drift:
         self.m_s = np.zeros(2)
         self._last: tuple[float, np.ndarray, np.ndarray] | None = None
 
-    def update(self, time_s: float, position_m: np.ndarray, heading_rad: float) -> None:
+    def update(self, time_s: float, position_m: np.ndarray, heading_rad: float, current_m_s: np.ndarray) -> None:
+        """``current_m_s``: the water's velocity as far as the swimmer knows it (and steers for
+        already): the drift is what is left."""
         forward = np.array([math.cos(heading_rad), math.sin(heading_rad)])
         # A cycle that turned hard (on the spot, after a jump) says nothing of the water: kept out.
         if self._last is not None and time_s > self._last[0] and float(forward @ self._last[2]) > self.STRAIGHT_COS:
             then_s, then_m, then_forward = self._last
-            velocity = (position_m[:2] - then_m[:2]) / (time_s - then_s)
+            velocity = (position_m[:2] - then_m[:2]) / (time_s - then_s) - current_m_s[:2]
             mean = then_forward + forward
             norm = math.hypot(mean[0], mean[1])
             along = mean / norm if norm > 1e-6 else forward
@@ -197,11 +225,15 @@ class TargetChooser:
 
     def __init__(self, target: Target, table: CalibrationTable, posture: str,
                  gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead: Lead = Lead(),
-                 level_off_beyond_rad: float | None = None, level_off_tempo: float = 1.0):
+                 level_off_beyond_rad: float | None = None, level_off_tempo: float = 1.0,
+                 water: Callable[[], Water] | None = None):
         """``level_off_beyond_rad``: starting (cycle 0) pitched nose up by more than this beyond
         any climb toward the target, take the stroke's ``level_off`` sequence instead of a pitch
-        correction, at ``level_off_tempo``, every cycle until it is not (None: it has none)."""
+        correction, at ``level_off_tempo``, every cycle until it is not (None: it has none).
+        ``water()``: the water swum in now; a target on a known path is then steered for in the
+        frame of the water's steady current where the swimmer is (``InWater``)."""
         self.target, self.table, self.posture, self.lead = target, table, posture, lead
+        self.water = water
         self.gains, self.tempo_control = gains, tempo
         self.level_off_beyond_rad, self.level_off_tempo = level_off_beyond_rad, level_off_tempo
         self._levelling = False
@@ -211,10 +243,12 @@ class TargetChooser:
     def __call__(self, cycle: int, state: BodyState, last_cycle: MeanAttitude | None) -> CycleChoice:
         position = state.com_m
         # Aim ahead along the target's path (and keep its pace) only where it is known (not a mouse
-        # or a jump).
+        # or a jump); that path as the water carrying the swimmer sees it.
         foresight = getattr(self.target, "foresight", True)
+        current = self._current_m_s(position, state.time_s)
+        path = InWater(self.target, current, state.time_s) if foresight and current.any() else self.target
         if foresight:
-            target, ahead_of_target_s, off_path_m = self.lead.aim(self.target, state.time_s, position)
+            target, ahead_of_target_s, off_path_m = self.lead.aim(path, state.time_s, position)
         else:
             target, ahead_of_target_s, off_path_m = self.target.position(state.time_s), 0.0, 0.0
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); pitch and
@@ -226,7 +260,7 @@ class TargetChooser:
         if self.lead.aim_off and foresight:      # on a known path (a jump's or the mouse's target has none)
             if cycle == 0:
                 self.drift.reset()
-            self.drift.update(state.time_s, position, att.heading_rad)
+            self.drift.update(state.time_s, position, att.heading_rad, current)
             target = self.drift.aimed_off(position, target, self.table.pace.speed_at(1.0))
         heading_error = bearing_error(position, target, att.heading_rad)
         distance = float(np.linalg.norm(self.target.position(state.time_s) - position))
@@ -245,7 +279,7 @@ class TargetChooser:
         # Levelling off, kick at the level-off tempo even for a target behind: a fast kick lies it down sooner.
         tempo = self.level_off_tempo if self._levelling else self.tempo_control.tempo_for(drive)
         if self.tempo_control.keep_pace and not waiting and foresight:
-            speed_m_s = target_speed_m_s(self.target, state.time_s + max(0.0, ahead_of_target_s), STEP_S)
+            speed_m_s = target_speed_m_s(path, state.time_s + max(0.0, ahead_of_target_s), STEP_S)
             tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(speed_m_s)))
         if not waiting:
             tempo = self.tempo_control.turning_tempo(tempo, heading_error, ahead_of_target_s)
@@ -265,6 +299,13 @@ class TargetChooser:
         # only where more is wanted); else they speed the swimmer past a slow target.
         return CycleChoice(weights, tempo, glide, self.tempo_control.glide_cycles if glide else 1.0,
                            thrust_demand=drive)
+
+    def _current_m_s(self, position_m: np.ndarray, time_s: float) -> np.ndarray:
+        """The water's steady horizontal velocity at ``position_m`` (zero with no water to read)."""
+        if self.water is None:
+            return np.zeros(3)
+        velocity = self.water().current_at(position_m, time_s, waves=False)[0]
+        return np.array([velocity[0], velocity[1], 0.0])
 
     def _attitude_weights(self, mean: MeanAttitude, position_m: np.ndarray, target_m: np.ndarray,
                           tempo: float) -> dict[str, float]:

@@ -99,15 +99,17 @@ class FlowField:
         self.spec, self.source = spec, source
         self.name = spec.name
 
-    def velocity_m_s(self, points_m: np.ndarray, time_s: float) -> np.ndarray:
-        """(n, 3) water velocity at (n, 3) world points at ``time_s``."""
+    def velocity_m_s(self, points_m: np.ndarray, time_s: float, waves: bool = True) -> np.ndarray:
+        """(n, 3) water velocity at (n, 3) world points at ``time_s``; without ``waves``, the steady
+        flow only (a wave's water circles: over a period it goes nowhere)."""
         points = np.atleast_2d(np.asarray(points_m, float))
         velocity = np.zeros_like(points)
         for flow in self.spec.flows:
             if isinstance(flow, UniformSpec):
                 velocity += (flow.velocity_m_s.x, flow.velocity_m_s.y, flow.velocity_m_s.z)
             elif isinstance(flow, WaveSpec):
-                velocity += _wave(flow, points, time_s)
+                if waves:
+                    velocity += _wave(flow, points, time_s)
             else:
                 velocity[:, :2] += _point_flow(flow, points)
         return velocity

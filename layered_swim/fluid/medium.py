@@ -41,11 +41,12 @@ class Medium:
     def current(self) -> np.ndarray:
         return np.asarray(self.current_m_s, dtype=float)
 
-    def current_at(self, points_m: np.ndarray, time_s: float) -> np.ndarray:
-        """(n, 3) water velocity at (n, 3) points: the current plus the flow field's."""
+    def current_at(self, points_m: np.ndarray, time_s: float, waves: bool = True) -> np.ndarray:
+        """(n, 3) water velocity at (n, 3) points: the current plus the flow field's (without
+        ``waves``, its steady part)."""
         points = np.atleast_2d(np.asarray(points_m, float))
         uniform = np.tile(self.current, (len(points), 1))
-        return uniform if self.flow is None else uniform + self.flow.velocity_m_s(points, time_s)
+        return uniform if self.flow is None else uniform + self.flow.velocity_m_s(points, time_s, waves)
 
     def to_json(self) -> dict:
         """The water as a run's resolved config records it (the flow field as its file's content)."""
