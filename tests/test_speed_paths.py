@@ -60,21 +60,29 @@ def test_one_call_loads_equal_wrenches_then_drive():
     assert pending[0].tobytes() == pending[1].tobytes()
 
 
+def _dot3(a, b):
+    """Dot products with 3-vectors (``b``), summed left to right: numpy's ``@`` goes through BLAS,
+    whose kernel (and so its rounding) depends on the CPU (an AVX-512 machine's differed in the
+    last bit)."""
+    return a[..., 0] * b[0] + a[..., 1] * b[1] + a[..., 2] * b[2]
+
+
 def _numpy_rules(previous, arms, rules, quat, linvel, flow_m_s, desired, dt_s, engagement):
     """The hand rules as numpy vector expressions (the compiled kernel's reference)."""
     pull, limit = np.zeros_like(previous), np.zeros_like(previous)
     for arm in arms:
         flow = flow_m_s[arm.hand] - linvel[arm.hand]
-        speed = math.sqrt(flow.dot(flow))
+        speed = math.sqrt(_dot3(flow, flow))
         if speed < 0.05:
             continue
         flow_dir = flow / speed
-        helpfulness, strength = float(flow_dir @ desired), min(speed, 1.0)
+        helpfulness, strength = _dot3(flow_dir, desired), min(speed, 1.0)
         if helpfulness > 0.0 or rules.palm.hindering:
             normal = _numpy_rotate(quat[arm.hand], np.array([0.0, 1.0, 0.0]))
             turning = np.cross(_numpy_rotate(quat[arm.forearm], arm.wrist_axes), normal)
-            facing, along = float(normal @ flow_dir), float(normal @ desired)
-            gradient = 2.0 * abs(facing) * along * (turning @ flow_dir) + facing * abs(facing) * (turning @ desired)
+            facing, along = _dot3(normal, flow_dir), _dot3(normal, desired)
+            toward_flow, toward_desired = _dot3(turning, flow_dir), _dot3(turning, desired)
+            gradient = 2.0 * abs(facing) * along * toward_flow + facing * abs(facing) * toward_desired
             pull[list(arm.palm_coords)] = rules.palm.gain * strength * gradient
             limit[list(arm.palm_coords)] = np.radians(rules.palm.max_deg)
         if helpfulness > 0.0 or rules.reach.hindering:

@@ -84,7 +84,7 @@ def rule_offsets(previous: np.ndarray, arms: Arms, rules: RulesSpec, quat_xyzw: 
 
 @njit(cache=True)
 def _dot3(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]   # numpy's own sum for two 3-vectors, to the bit
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]   # left to right, the same bits on every machine
 
 
 @njit(cache=True)
@@ -98,8 +98,8 @@ def _clip(x, lo, hi):
 def _rule_offsets(previous, index, wrist_axes, palm_gain, palm_limit, reach_gain, reach_limit, palm, palm_hindering,
                   reach, reach_hindering, quat, linvel, flow_m_s, desired, dt_s, engagement):
     """``rule_offsets`` compiled (it runs every control step; numpy on 3-vectors cost ~40 us): the
-    same operations in the same order as numpy's vector expressions were, so the same bits; the
-    limits in rad."""
+    same operations in the same order as numpy's vector expressions with 3-vector dot products
+    summed left to right (the test's reference), so the same bits; the limits in rad."""
     n = previous.shape[0]
     pull = np.zeros(n)
     limit = np.zeros(n)
@@ -124,9 +124,10 @@ def _rule_offsets(previous, index, wrist_axes, palm_gain, palm_limit, reach_gain
             # A flat plate's pressure force lies along its normal, ~ facing*|facing|; its useful part is
             # that times the normal's component along the desired direction. Climb that thrust: the palm
             # faces the flow when the push helps and slices through it when it hinders.
-            toward_flow, toward_desired = np.dot(turning, flow_dir), np.dot(turning, desired)   # numpy's gemv
             for k in range(2):
-                gradient = 2.0 * abs(facing) * along * toward_flow[k] + facing * abs(facing) * toward_desired[k]
+                # Summed here, not by BLAS (np.dot): its kernel, and so the last bit, depends on the CPU.
+                toward_flow, toward_desired = _dot3(turning[k], flow_dir), _dot3(turning[k], desired)
+                gradient = 2.0 * abs(facing) * along * toward_flow + facing * abs(facing) * toward_desired
                 pull[index[a, 2 + k]] = palm_gain * strength * gradient
                 limit[index[a, 2 + k]] = palm_limit
         if reach and (helpfulness > 0.0 or reach_hindering):
