@@ -37,12 +37,18 @@ def test_each_start_draws_its_own_push_within_the_asked_range():
     np.testing.assert_array_equal(rb.push_of({"start": 3}, weight_n)[0], rb.push_of({"start": 3}, weight_n)[0])
 
 
-def test_back_on_the_path_is_timed_from_the_push_after_the_largest_excursion():
+def test_back_on_the_path_is_timed_from_the_push_to_the_end_of_the_excursion_it_caused():
     t = np.arange(0.0, 40.0, 0.5)
-    off = np.where((t >= 20) & (t < 24), 2.0, 0.5)        # pushed 2 m off at 20 s, back at 24 s
-    assert rb.back_after(t, off, 20.0) == pytest.approx(4.0)
-    assert rb.back_after(t, np.full_like(t, 0.5), 20.0) == 0.0
-    assert rb.back_after(t, np.where(t >= 20, 2.0, 0.5), 20.0) is None
+    off = np.where((t >= 20.5) & (t < 24), 2.0, 0.5)        # pushed 2 m off at 20 s, back at 24 s
+    assert rb.back_after(t, off, 20.0, 20.1) == pytest.approx(4.0)
+    assert rb.back_after(t, np.full_like(t, 0.5), 20.0, 20.1) == 0.0
+    assert rb.back_after(t, np.where(t >= 20, 2.0, 0.5), 20.0, 20.1) is None
+    # Out at the push already (a corner): back when that excursion ends.
+    assert rb.back_after(t, np.where((t >= 18) & (t < 22), 2.0, 0.5), 20.0, 20.1) == pytest.approx(2.0)
+    # A corner overshot 10 s on is the path's doing: the push did not carry it out.
+    later = np.where((t >= 30) & (t < 35), 2.0, 0.5)
+    assert rb.back_after(t, later, 20.0, 20.1) == 0.0
+    assert rb.back_after(t, np.maximum(off, later), 20.0, 20.1) == pytest.approx(4.0)
 
 
 def test_the_table_holds_a_cell_at_one_metre_and_takes_medians_over_starts():

@@ -40,6 +40,8 @@ DENSITIES_KG_M3 = (900.0, 1100.0, 1250.0, 1500.0)
 PUSH_AT_S = 20.0
 PUSH_MG = (1.0, 3.0)             # body weights, drawn per start
 PUSH_S = (0.05, 0.2)             # how long, drawn per start
+# A push carries the swimmer out within about a cycle; an excursion beginning later is the path's.
+PUSH_EFFECT_S = 3.0
 SECONDS = 60.0
 STARTS = 10
 QUICK = {"strokes": STROKES, "paths": ("figure_eight", "straight_line"), "starts": 2, "seconds": 30.0,
@@ -95,19 +97,22 @@ def run(config: dict) -> dict:
     if config["condition"] == "push":
         path = episode.task.target.path_points(2000)
         off_path = np.array([float(np.min(np.linalg.norm(path - p, axis=1))) for p in a["swimmer_m"]])
-        result["back_s"] = back_after(a["track_time_s"], off_path, PUSH_AT_S)
+        result["back_s"] = back_after(a["track_time_s"], off_path, start_s, end_s)
     return result
 
 
-def back_after(time_s, off_path_m, push_s: float) -> float | None:
-    """Seconds from the push until back within BACK_WITHIN_M of the path after the largest
-    excursion that followed it (0: never out); None: not back by the run's end."""
+def back_after(time_s, off_path_m, push_s: float, push_end_s: float) -> float | None:
+    """Seconds from the push until back within BACK_WITHIN_M of the path at the end of the
+    excursion beyond it that the push caused: the first one out at any time from the push until
+    PUSH_EFFECT_S after it ended (one under way at the push counts). 0: the push did not carry the
+    swimmer out; None: not back by the run's end. An excursion that begins later (a corner
+    overshot half a minute on) is the path's, not the push's."""
     t, d = np.asarray(time_s), np.asarray(off_path_m)
-    after = np.flatnonzero(t >= push_s)
-    worst = after[np.argmax(d[after])]
-    if d[worst] <= BACK_WITHIN_M:
+    out = d > BACK_WITHIN_M
+    caused = np.flatnonzero(out & (t >= push_s) & (t <= push_end_s + PUSH_EFFECT_S))
+    if not len(caused):
         return 0.0
-    back = np.flatnonzero((t > t[worst]) & (d <= BACK_WITHIN_M))
+    back = np.flatnonzero((t > t[caused[0]]) & ~out)
     return float(t[back[0]] - push_s) if len(back) else None
 
 
