@@ -4,7 +4,7 @@ cell the median over moved starts. A cell holds when its median mean distance to
 at most ``HOLD_M``; after a push, the swimmer should be back within ``BACK_WITHIN_M`` of the path in
 at most ``BACK_WITHIN_S`` seconds.
 
-The full sweep is 3780 minute-long swims (~40 min on two cores): it is cached run by run in
+The full sweep is 3780 minute-long swims (~1 hour on two cores): it is cached run by run in
 the output folder, so a stopped sweep goes on where it stopped, and ``--ray ADDRESS`` spreads it
 over a Ray cluster."""
 from __future__ import annotations
