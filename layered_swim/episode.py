@@ -108,18 +108,19 @@ class Episode:
             raise
 
     def _build_controller(self, stroke, strokes, layout, layers, weights, tempo, tempo_control, fluid):
+        def water():           # the water swum in now (the app may change it)
+            return fluid.medium
+
         if stroke != AUTO:
             return _controller(self.stroke, self.body, layout, self.task.target, layers, weights, tempo, tempo_control,
-                               lambda: fluid.medium)
+                               water)
         if self.task.target is None or weights is not None or not layers.cycle:
             raise ConfigError("--stroke auto chooses strokes to chase a target: it needs one (follow, goal, "
                               "the app) and the per-cycle layer")
-        # auto weighs what the target asks against the water swum in (the app may change it).
+        # auto weighs what the target asks against the water swum in.
         return AutoStrokeController(
-            {name: _controller(s, self.body, layout, self.task.target, layers, None, tempo, tempo_control,
-                               lambda: fluid.medium)
-             for name, s in strokes.items()}, self.task.target,
-            medium=lambda: fluid.medium)
+            {name: _controller(s, self.body, layout, self.task.target, layers, None, tempo, tempo_control, water)
+             for name, s in strokes.items()}, self.task.target, medium=water)
 
     @property
     def controller(self):
