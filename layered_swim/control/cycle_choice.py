@@ -50,7 +50,12 @@ class TempoControl:
     stroke whose turn per cycle holds as its tempo rises turns more per second: the re-authored
     crawl and breaststroke, whose slow cycles could not follow the figure-eight's bends). A glide
     lasts ``glide_cycles`` of a cycle: a crawl's kick keeps it moving through a glide, and a
-    whole cycle of it overshot a slow target."""
+    whole cycle of it overshot a slow target.
+
+    ``dive_tempo``: at least this tempo while the point steered for lies more than ``dive_below_m``
+    below the centre of mass (a stroke that lies nose-up when slow cannot pitch down far enough to
+    dive there: the breaststroke lies at 21 deg at tempo 0.7 and its pitch-down sequence takes it
+    only to -8 deg; at full tempo it lies at 9 deg and pitches to -14)."""
 
     min_tempo: float = 0.5
     keep_pace: bool = True
@@ -62,6 +67,8 @@ class TempoControl:
     far_m: float = 0.6
     easy_turn_rad: float = math.radians(30.0)
     wide_turn_rad: float = math.radians(90.0)
+    dive_tempo: float | None = None
+    dive_below_m: float = 0.3
 
     def drive(self, distance_m: float, heading_error_rad: float = 0.0) -> float:
         """How hard to swim, 0 (slowest) to 1 (full tempo)."""
@@ -76,6 +83,12 @@ class TempoControl:
         if (self.turn_tempo is not None and abs(heading_error_rad) > self.easy_turn_rad
                 and ahead_of_target_s <= self.turn_tempo_until_ahead_s):
             return max(tempo, self.turn_tempo)
+        return tempo
+
+    def diving_tempo(self, tempo: float, below_m: float) -> float:
+        """``tempo``, raised to ``dive_tempo`` for a point to swim to ``below_m`` below."""
+        if self.dive_tempo is not None and below_m > self.dive_below_m:
+            return max(tempo, self.dive_tempo)
         return tempo
 
 
@@ -283,6 +296,8 @@ class TargetChooser:
             tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(speed_m_s)))
         if not waiting:
             tempo = self.tempo_control.turning_tempo(tempo, heading_error, ahead_of_target_s)
+        if not self._levelling:
+            tempo = self.tempo_control.diving_tempo(tempo, float(position[2] - target[2]))
         yaw = wanted_yaw(att, position, target, self.gains)
         near = (distance < self.tempo_control.glide_within_m
                 and (not foresight or ahead_of_target_s > self.lead.glide_ahead_s))

@@ -116,6 +116,9 @@ class SteeringSpec(Strict):
     # turn_tempo_until_ahead_s ahead of a moving one along its path (none: the tempo it has anyway).
     turn_tempo: float | None = Field(None, ge=0.5, le=1.5)
     turn_tempo_until_ahead_s: float = Field(0.0, ge=-10.0, le=10.0)
+    # At least this tempo while the point steered for lies more than 0.3 m below (none: any): a
+    # stroke that lies nose-up when slow cannot pitch down far enough to dive at its pace.
+    dive_tempo: float | None = Field(None, ge=0.5, le=1.5)
     # On a moving target's known path: aim this far ahead where it bends (1.5 s where it runs
     # straight), and wait (slowest tempo, or glide) when more than wait_ahead_s ahead of it.
     lead_bend_s: float = Field(3.0, ge=1.5, le=10.0)
