@@ -244,6 +244,23 @@ def test_turning_toward_a_target_off_the_heading_swims_at_the_turn_tempo():
     assert ahead.tempo == pytest.approx(1.0)
 
 
+def test_far_behind_a_moving_target_swims_at_the_turn_tempo():
+    """Behind a target moving along a known path and more than catch_up_beyond_m from it, a stroke
+    swims at its turn tempo; nearer, ahead of it, or with a target whose path is unknown (a jump),
+    at the tempo it has anyway."""
+    catching = TempoControl(turn_tempo=1.2, catch_up_beyond_m=2.0)
+    assert catching.catching_up_tempo(1.0, 2.1, -0.5) == pytest.approx(1.2)
+    assert catching.catching_up_tempo(1.0, 1.9, -0.5) == pytest.approx(1.0)
+    assert catching.catching_up_tempo(1.0, 2.1, 0.5) == pytest.approx(1.0)
+    assert TempoControl(turn_tempo=1.2).catching_up_tempo(1.0, 5.0, -1.0) == pytest.approx(1.0)
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
+    ahead_along_x = TrajectoryTarget(np.array([[3.0, 0.0, 0.0], [33.0, 0.0, 0.0]]), np.array([0.0, 60.0]), 1.0, False)
+    assert TargetChooser(ahead_along_x, table(), "prone", tempo=catching)(0, state, None).tempo == pytest.approx(1.2)
+    assert TargetChooser(ahead_along_x, table(), "prone")(0, state, None).tempo == pytest.approx(1.0)
+    jumped = FixedTarget((3.0, 0.0, 0.0))
+    assert TargetChooser(jumped, table(), "prone", tempo=catching)(0, state, None).tempo == pytest.approx(1.0)
+
+
 def test_diving_swims_at_least_at_the_dive_tempo():
     """A target behind (the slowest tempo, turning round) and over 0.3 m below: a stroke with
     dive_tempo 1.0 swims at 1.0 (it lies flatter and pitches down further at speed); at its own

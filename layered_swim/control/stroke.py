@@ -116,6 +116,9 @@ class SteeringSpec(Strict):
     # turn_tempo_until_ahead_s ahead of a moving one along its path (none: the tempo it has anyway).
     turn_tempo: float | None = Field(None, ge=0.5, le=1.5)
     turn_tempo_until_ahead_s: float = Field(0.0, ge=-10.0, le=10.0)
+    # At turn_tempo too while behind a moving target along its path and farther than this from it
+    # (none: never): at the target's pace the gap stays.
+    catch_up_beyond_m: float | None = Field(None, gt=0.0, le=100.0)
     # At least this tempo while the point steered for lies more than 0.3 m below (none: any): a
     # stroke that lies nose-up when slow cannot pitch down far enough to dive at its pace.
     dive_tempo: float | None = Field(None, ge=0.5, le=1.5)
