@@ -70,6 +70,40 @@ def test_hold_dive_and_sprint_come_before_keeping_up():
     assert RULE.choose(TURN, Ask(5.0, 1.0, AHEAD, 1.0, depth_m=0.5), ABILITIES) == SPRINT
 
 
+# Made-up strokes for reaching: "fast" is the quickest but turns widely, "back" swims on its back.
+REACHERS = ABILITIES | {"back": Ability(2.0, 0.5, face_down=False)}
+GOING = 0.6      # m/s: already swimming
+
+
+@pytest.mark.parametrize("active, distance, error_deg, speed, expected", [
+    # 8 m straight ahead: TURN 8/0.8 = 10 s (no change), "tight" 8/1.0 + 2 = 10, the crawl 8.7, "fast"
+    # 7.3 s; "back" (6 s) does not face where it goes.
+    (TURN, 8.0, 0.0, GOING, "fast"),
+    # 30 deg off: "fast" would circle round it (8 m x 0.1 rad/m < 2 sin 30 deg); the crawl 10.1 s,
+    # "tight" 11.0, TURN 11.6.
+    (TURN, 8.0, 30.0, GOING, SPRINT),
+    (TURN, 8.0, 0.0, 0.1, TURN),            # from a standstill the breaststroke sets off first...
+    (TURN, 8.0, 90.0, GOING, TURN),         # ...and turns toward it first
+    (TURN, 3.5, 0.0, GOING, TURN),          # not far: no change of stroke
+    ("fast", 3.5, 0.0, 0.1, "fast"),        # one under way goes on until reach_until_m...
+    ("fast", 1.5, 0.0, GOING, TURN),
+])
+def test_a_far_still_target_is_reached_with_the_stroke_that_gets_there_soonest(active, distance, error_deg,
+                                                                               speed, expected):
+    ask = Ask(distance, 0.0, math.radians(error_deg), speed_m_s=speed)
+    assert RULE.choose(active, ask, REACHERS) == expected
+    assert RULE.choose(active, ask._replace(target_speed_m_s=0.5), REACHERS) == TURN     # a moving one: not
+
+
+def test_arriving_fast_the_hold_starts_where_coasting_takes_the_swimmer_near():
+    """Treading water from 1.2 m/s it coasts on 2 m (and overshot stations by 3-4 m)."""
+    assert not RULE.holds(TURN, 2.5, 0.0, closing_m_s=0.0)
+    assert not RULE.holds(TURN, 2.5, 0.0, closing_m_s=1.0)          # coasts to 1.0 m: not yet
+    assert RULE.holds(TURN, 2.5, 0.0, closing_m_s=1.5)              # coasts to 0.25 m
+    assert RULE.holds(TURN, 0.9, 0.0, closing_m_s=-0.5)             # within hold_within_m, whatever its speed
+    assert not RULE.holds(TURN, 2.5, 0.5, closing_m_s=1.5)          # a moving target is followed
+
+
 def test_a_strokes_ability_is_read_off_its_calibration():
     episode = Episode("auto", FollowTarget(FixedTarget([2.5, 0.0, -0.3])))
     try:
@@ -147,21 +181,26 @@ def test_auto_needs_a_target():
 
 def test_auto_starts_holding_a_still_target_as_soon_as_it_is_in_reach():
     """Not at the next cycle end: a breaststroke turning tightly round the target may be in reach
-    only between its cycle ends."""
-    episode = Episode("auto", FollowTarget(FixedTarget([2.5, 0.0, -0.3])))
+    only between its cycle ends (in reach: within hold_within_m, or coasting to it)."""
+    goal = np.array([2.5, 0.0, -0.3])
+    episode = Episode("auto", FollowTarget(FixedTarget(goal)))
+
+    def seen(sim):
+        away = goal[:2] - sim.state.com_m[:2]
+        closing = float(sim.state.com_vel_m_s[:2] @ away / np.linalg.norm(away))
+        return (sim.time_s, episode.controller.controllers[TURN].cycle_start_s,
+                episode.controller.controllers[TURN].cycles_per_s, float(np.linalg.norm(away)), closing)
     try:
         switched = []
         episode.run(8.0, observers=[lambda sim: switched or not episode.controller.switches or switched.append(
-            (sim.time_s, episode.controller.controllers[TURN].cycle_start_s,
-             episode.controller.controllers[TURN].cycles_per_s,
-             float(np.linalg.norm(sim.state.com_m - [2.5, 0.0, -0.3]))))])
+            seen(sim))])
         controller = episode.controller
     finally:
         episode.close()
     assert controller.switches[0].stroke == HOLD
-    time_s, cycle_start_s, cycles_per_s, distance_m = switched[0]
+    time_s, cycle_start_s, cycles_per_s, distance_m, closing_m_s = switched[0]
     assert (time_s - cycle_start_s) * cycles_per_s < 0.95      # mid-cycle
-    assert distance_m < RULE.hold_within_m + 0.05
+    assert distance_m - RULE.hold_coast_s * closing_m_s < RULE.hold_coast_to_m + 0.05
 
 
 def test_auto_leaves_a_held_target_the_moment_it_jumps_away():
@@ -184,16 +223,21 @@ def test_auto_leaves_a_held_target_the_moment_it_jumps_away():
     assert (left_s - cycle_start_s) * cycles_per_s < 0.95      # mid-cycle
 
 
-def test_after_treading_water_the_breaststroke_lies_down_and_gets_away():
-    """Standing after a hold, the breaststroke's pitch correction lays the body down (it has no
-    level-off sequence now: with the one written for the stroke before issue 36 it got away later,
-    3.2 against 3.0 m): 8 s after the target jumps 8 m ahead it is within 3.5 m of it."""
-    jump = StationTarget(np.array([[2.5, 0.0, -0.3], [10.5, 0.0, -0.3]]), np.array([0.0, 9.0]))
+def test_after_treading_water_auto_gets_away_and_reaches_a_far_jump_with_the_soonest_stroke():
+    """Standing after a hold, the breaststroke lays the body down and gets it going; then the stroke
+    that gets there soonest (the butterfly, by the shipped calibrations) swims the rest, and it
+    treads water again where it coasts to the target: 8 m reached within 12 s."""
+    goal = np.array([10.5, 0.0, -0.3])
+    jump = StationTarget(np.array([[2.5, 0.0, -0.3], goal]), np.array([0.0, 9.0]))
     episode = Episode("auto", FollowTarget(jump))
-    assert episode.controller.controllers[TURN].chooser.level_off_beyond_rad is None
     try:
-        episode.run(17.0)
-        left_m = float(np.linalg.norm(episode.sim.state.com_m - [10.5, 0.0, -0.3]))
+        soonest = RULE.soonest(TURN, Ask(8.0, 0.0, 0.0), episode.controller.abilities)
+        reached = []
+        episode.run(21.0, observers=[lambda sim: reached or np.linalg.norm(sim.state.com_m - goal) > 1.0
+                                     or reached.append(sim.time_s)])
+        switches = [s.stroke for s in episode.controller.switches if s.time_s >= 9.0]
     finally:
         episode.close()
-    assert left_m < 3.5
+    assert soonest == "butterfly"
+    assert switches == [TURN, soonest, HOLD]
+    assert reached and reached[0] - 9.0 < 12.0

@@ -16,6 +16,7 @@ from layered_swim.control.steering import (
     Attitude,
     MeanAttitude,
     SteeringGains,
+    attitude,
     attitude_errors,
     attitude_of,
     glide_pitch,
@@ -35,7 +36,8 @@ from layered_swim.control.stroke import (
 )
 from layered_swim.control.targets import FixedTarget, TrajectoryTarget, load_trajectory
 from layered_swim.episode import Episode
-from layered_swim.sim.simulation import PRONE_QUAT_XYZW
+from layered_swim.geometry import quat_multiply
+from layered_swim.sim.simulation import PRONE_QUAT_XYZW, SUPINE_QUAT_XYZW
 from layered_swim.spec import GOAL_TEMPO
 from layered_swim.state import BodyState, Segments
 from layered_swim.tasks import FollowTarget
@@ -131,6 +133,42 @@ def test_wanted_yaw_and_attitude_errors_from_target_position():
     surface = SteeringGains(depth_within_m=0.2)
     assert glide_pitch(np.zeros(3), np.array([2.0, 0.0, -0.15]), surface) == 0.0
     assert glide_pitch(np.zeros(3), np.array([5.0, 0.0, -2.2]), surface) == pytest.approx(-math.atan2(2.0, 5.0))
+
+
+def test_a_target_dead_behind_is_turned_to_the_side_the_turn_already_goes():
+    """Noise of a degree either side of dead behind flips the shorter side; a turn under way keeps
+    its side there, but a target newly behind (a jump) is turned to the shorter side."""
+    gains = SteeringGains(yaw_fraction=0.5)
+    facing_x = Attitude(heading_rad=0.0, pitch_rad=0.0, roll_rad=0.0)
+    behind_right = np.array([-5.0, -0.2, 0.0])          # 177.7 deg to the right
+    error = -math.pi + math.atan2(0.2, 5.0)
+    assert wanted_yaw(facing_x, np.zeros(3), behind_right, gains) == pytest.approx(0.5 * error)
+    assert wanted_yaw(facing_x, np.zeros(3), behind_right, gains, last_error_rad=math.radians(170.0)) == (
+        pytest.approx(0.5 * (error + 2 * math.pi)))          # was turning left round to it: on left
+    for last_deg in (20.0, -170.0):                        # not behind then, or already on the right
+        assert wanted_yaw(facing_x, np.zeros(3), behind_right, gains,
+                          last_error_rad=math.radians(last_deg)) == pytest.approx(0.5 * error)
+
+
+def _pitched_up(base_quat, pitch_deg: float, heading_deg: float) -> np.ndarray:
+    """A lying body's base orientation pitched nose up about its own left, then turned to heading."""
+    half_p, half_h = math.radians(pitch_deg) / 2, math.radians(heading_deg) / 2
+    nose_up = np.array([0.0, -math.sin(half_p), 0.0, math.cos(half_p)])      # about world -y: +x tilts up
+    turn = np.array([0.0, 0.0, math.sin(half_h), math.cos(half_h)])
+    return quat_multiply(turn, quat_multiply(nose_up, np.asarray(base_quat, float)))
+
+
+@pytest.mark.parametrize("posture, base", [("prone", PRONE_QUAT_XYZW), ("supine", SUPINE_QUAT_XYZW)])
+def test_a_lying_body_standing_up_heads_where_it_would_lie_down(posture, base):
+    """Past upright (pitched 95 deg) the long axis leans back, the way opposite to where the body
+    faces; read ``facing``, the heading is the way it lies down, as it is at a lower pitch."""
+    for pitch_deg in (20.0, 70.0, 95.0):
+        quat = _pitched_up(base, pitch_deg, 30.0)
+        att = attitude(quat, quat, posture, facing=True)
+        assert att.pitch_rad == pytest.approx(math.radians(min(pitch_deg, 180.0 - pitch_deg)))
+        assert math.degrees(att.heading_rad) == pytest.approx(30.0)
+    long_axis = attitude(_pitched_up(base, 95.0, 30.0), _pitched_up(base, 95.0, 30.0), posture)
+    assert math.degrees(long_axis.heading_rad) == pytest.approx(-150.0)
 
 
 def test_the_chooser_holds_pitch_toward_the_target_depth_and_keeps_the_offset():

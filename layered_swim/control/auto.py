@@ -4,14 +4,19 @@ the target asks, switched between stroke cycles.
 Each stroke keeps its own layered controller (its calibration, steering and rules). At the end
 of every cycle of the stroke swimming now, ``StrokeChoice`` looks at the target:
 
-- **hold**: a target that stays put (or creeps) within ``hold_within_m`` is held by treading
-  water, which stays where it is and turns on the spot; treading goes on until the target is
-  ``hold_leave_m`` away or starts moving;
+- **hold**: a target that stays put (or creeps) within ``hold_within_m`` (or that the swimmer,
+  arriving fast, would coast to within ``hold_coast_to_m`` of) is held by treading water, which
+  stays where it is and turns on the spot; treading goes on until the target is ``hold_leave_m``
+  away or starts moving;
 - **dive**: a target deeper than ``dive_beyond_m`` is followed with the breaststroke, the one
   stroke that holds a depth (the others ride the surface);
-- **sprint**: a target far ahead (``sprint_beyond_m``, within ``sprint_ahead_rad`` of the
+- **reach**: a target that stays put farther than ``reach_beyond_m`` (a jump, a click) is swum to
+  with the stroke that gets there soonest by its ``Ability`` (``soonest``), once the body swims
+  and heads toward it, until within ``reach_until_m``, where the approach and the hold take over
+  (alone, the breaststroke took up to 24 s to reach a jump 8-10 m away, the butterfly at most 11);
+- **sprint**: a moving target far ahead (``sprint_beyond_m``, within ``sprint_ahead_rad`` of the
   heading) is chased with the crawl, until it is near or off to the side (only far: from a
-  standstill the crawl's first cycles wobble, and a breaststroke reaches a jump 8-10 m away sooner);
+  standstill the crawl's first cycles wobble);
 - **keep up**: a target that asks more speed through the water than the breaststroke swims
   comfortably (its speed less the water's, beyond ``keep_up_share`` of the breaststroke's full
   pace: a fast target, or a current to fight) is followed with the stroke that turns most per
@@ -47,17 +52,20 @@ AUTO_STROKES = (TURN, SPRINT, HOLD, "butterfly", "backstroke")      # the first 
 
 class Ability(NamedTuple):
     """What a stroke can do, from its calibration: its steady speed at full tempo, and how much its
-    yaw sequences turn it per metre swum at full tempo (the weaker side, at its strongest weight)."""
+    yaw sequences turn it per metre swum at full tempo (the weaker side, at its strongest weight);
+    and whether it swims face down, seeing where it goes."""
 
     top_m_s: float
     turn_rad_per_m: float
+    face_down: bool = True
 
 
 def ability_of(controller: LayeredController) -> Ability:
     table = controller.chooser.table
     top_m_s = table.pace.speed_at(1.0)
     turn_rad = min(float(np.max(table.turn_at(name, 1.0))) for name in table.turn_rad)
-    return Ability(top_m_s, turn_rad / (top_m_s * controller.stroke.period_s))
+    return Ability(top_m_s, turn_rad / (top_m_s * controller.stroke.period_s),
+                   controller.stroke.start.posture == "prone")
 
 
 class Ask(NamedTuple):
@@ -68,12 +76,18 @@ class Ask(NamedTuple):
     heading_error_rad: float
     pace_m_s: float = 0.0      # the speed through the water that keeps with it (its velocity less the water's)
     depth_m: float = 0.0
+    speed_m_s: float = 0.0     # the swimmer's own horizontal speed through the water
+    closing_m_s: float = 0.0   # how fast it nears the target (horizontally, over the ground)
 
 
 @dataclass(frozen=True)
 class StrokeChoice:
     hold_within_m: float = 1.0
     hold_leave_m: float = 2.0
+    # Arriving fast, the swimmer coasts on once it treads water (about its closing speed times
+    # hold_coast_s): holding starts where it would coast to within hold_coast_to_m.
+    hold_coast_s: float = 1.5
+    hold_coast_to_m: float = 0.5
     still_m_s: float = 0.2            # a target slower than this stays put
     sprint_beyond_m: float = 12.0
     sprint_until_m: float = 3.0
@@ -84,21 +98,42 @@ class StrokeChoice:
     # A target that moved faster than any swimmer has jumped (a station, the mouse): it asks no pace.
     jumped_beyond_m_s: float = 3.0
     dive_beyond_m: float = 1.0
+    reach_beyond_m: float = 4.0
+    reach_until_m: float = 2.0
+    # What a change of stroke costs in reaching: the blend and a first cycle from the last one's pose.
+    switch_cost_s: float = 2.0
+    # Only from a body already swimming this fast: from treading water, upright and still, the
+    # butterfly stalled nose-up and never got going; the breaststroke levels off first.
+    reach_from_m_s: float = 0.5
+    # ...heading within this of the target: slow, the butterfly stalled turning round (pitched up 77 deg).
+    reach_ahead_rad: float = math.radians(60.0)
     blend_s: float = 0.5
 
-    def holds(self, active: str, distance_m: float, target_speed_m_s: float) -> bool:
-        """Whether to tread water at (or keep holding) the target: it stays put and is near."""
-        return target_speed_m_s < self.still_m_s and distance_m < (
-            self.hold_leave_m if active == HOLD else self.hold_within_m)
+    def holds(self, active: str, distance_m: float, target_speed_m_s: float, closing_m_s: float = 0.0) -> bool:
+        """Whether to tread water at (or keep holding) the target: it stays put and is near (or
+        will be, coasting at ``closing_m_s``)."""
+        if target_speed_m_s >= self.still_m_s:
+            return False
+        if active == HOLD:
+            return distance_m < self.hold_leave_m
+        coasts_to_m = distance_m - self.hold_coast_s * max(0.0, closing_m_s)
+        return distance_m < self.hold_within_m or coasts_to_m < self.hold_coast_to_m
 
     def choose(self, active: str, ask: Ask, abilities: dict[str, Ability] | None = None) -> str:
         """``abilities``: the strokes that may keep up with a fast target (none: only the
         breaststroke, crawl and treading water are chosen)."""
-        if self.holds(active, ask.distance_m, ask.target_speed_m_s):
+        if self.holds(active, ask.distance_m, ask.target_speed_m_s, ask.closing_m_s):
             return HOLD
         if ask.depth_m > self.dive_beyond_m:
             return TURN
         distance, error = ask.distance_m, abs(ask.heading_error_rad)
+        if abilities and ask.target_speed_m_s < self.still_m_s:
+            soonest = self.soonest(active, ask, abilities)
+            going_on = soonest == active and distance > self.reach_until_m
+            starting = (distance > self.reach_beyond_m and ask.speed_m_s >= self.reach_from_m_s
+                        and error < self.reach_ahead_rad)
+            if soonest != TURN and (going_on or starting):
+                return soonest
         if (distance > self.sprint_beyond_m and error < self.sprint_ahead_rad) or (
                 active == SPRINT and distance > self.sprint_until_m and error < self.sprint_keep_rad):
             return SPRINT
@@ -108,6 +143,24 @@ class StrokeChoice:
             if ask.pace_m_s > share * abilities[TURN].top_m_s:
                 return self.keeping_up(ask.pace_m_s, abilities)
         return TURN
+
+    def soonest(self, active: str, ask: Ask, abilities: dict[str, Ability]) -> str:
+        """The stroke that would reach the target soonest: the distance at its full pace plus the
+        heading error at its full turn rate, plus ``switch_cost_s`` for any but ``active``. Only
+        strokes that face down (on its back, the backstroke took 11-20 s to reach a jump of 8-10 m:
+        it swims blind and turns least per metre), and only those whose tightest turn at full pace
+        does not circle round the target (alone, the butterfly circles a reached station 2-3 m out);
+        the breaststroke where none is left."""
+        def time_s(name: str) -> float:
+            a = abilities[name]
+            swim_s = (ask.distance_m + abs(ask.heading_error_rad) / a.turn_rad_per_m) / a.top_m_s
+            return swim_s + (0.0 if name == active else self.switch_cost_s)
+
+        def reachable(a: Ability) -> bool:
+            # Within the circle of its tightest turn on the target's side: d < 2 R |sin(error)|.
+            return ask.distance_m * a.turn_rad_per_m >= 2.0 * abs(math.sin(ask.heading_error_rad))
+        fit = [name for name, a in abilities.items() if a.face_down and reachable(a)]
+        return min(fit, key=time_s) if fit else TURN
 
     def keeping_up(self, asked_m_s: float, abilities: dict[str, Ability]) -> str:
         """The stroke that turns most per metre among those fast enough for ``asked_m_s``, else the fastest."""
@@ -202,7 +255,7 @@ class AutoStrokeController:
         heading = attitude_of(state, self.current.stroke.start.posture).heading_rad
         ask = Ask(float(np.linalg.norm(goal - position)), target_speed_m_s(self.target, state.time_s),
                   bearing_error(position, goal, heading), self._asked_m_s(state.time_s, position),
-                  self.medium().surface_z_m - float(goal[2]))
+                  self.medium().surface_z_m - float(goal[2]), self._speed_m_s(state), self._closing_m_s(state))
         return self.choice_rule.choose(self.active, ask, self.abilities)
 
     def _asked_m_s(self, time_s: float, position_m: np.ndarray) -> float:
@@ -214,6 +267,15 @@ class AutoStrokeController:
         velocity = velocity - self.medium().current_at(position_m, time_s, waves=False)[0]
         return float(np.hypot(velocity[0], velocity[1]))
 
+    def _speed_m_s(self, state: BodyState) -> float:
+        velocity = state.com_vel_m_s - self.medium().current_at(state.com_m, state.time_s, waves=False)[0]
+        return float(np.hypot(velocity[0], velocity[1]))
+
+    def _closing_m_s(self, state: BodyState) -> float:
+        away = self.target.position(state.time_s)[:2] - state.com_m[:2]
+        distance_m = float(np.linalg.norm(away))
+        return float(state.com_vel_m_s[:2] @ away) / distance_m if distance_m > 1e-9 else 0.0
+
     def _hold_changes_now(self, state: BodyState) -> bool:
         """Whether holding should start or end now, mid-cycle: a still target come within reach is
         held at once (a stroke turning tightly round it may pass within ``hold_within_m`` only
@@ -221,7 +283,8 @@ class AutoStrokeController:
         if self._from_pose is not None:
             return False
         distance_m = float(np.linalg.norm(self.target.position(state.time_s) - state.com_m))
-        holds = self.choice_rule.holds(self.active, distance_m, target_speed_m_s(self.target, state.time_s))
+        holds = self.choice_rule.holds(self.active, distance_m, target_speed_m_s(self.target, state.time_s),
+                                       self._closing_m_s(state))
         return holds != (self.active == HOLD)
 
     def _switch(self, name: str, time_s: float) -> None:

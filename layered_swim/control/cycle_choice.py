@@ -263,6 +263,7 @@ class TargetChooser:
         self.gains, self.tempo_control = gains, tempo
         self.level_off_beyond_rad, self.level_off_tempo = level_off_beyond_rad, level_off_tempo
         self._levelling = False
+        self._last_error_rad = 0.0      # the last cycle's heading error, as steered
         self.held_rad = {"pitch": 0.0, "roll": 0.0}     # the attitude offsets the sequences hold
         self.drift = Drift()
 
@@ -279,10 +280,11 @@ class TargetChooser:
             target, ahead_of_target_s, off_path_m = self.target.position(state.time_s), 0.0, 0.0
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); pitch and
         # roll to steer averaged over the last cycle.
-        att = attitude_of(state, self.posture)
+        att = attitude_of(state, self.posture, facing=cycle == 0)     # a spell may start standing up
         mean = last_cycle if last_cycle is not None else MeanAttitude(att.pitch_rad, att.roll_rad)
         if cycle == 0:
             self.held_rad = {"pitch": 0.0, "roll": 0.0}
+            self._last_error_rad = 0.0
         if self.lead.aim_off and foresight:      # on a known path (a jump's or the mouse's target has none)
             if cycle == 0:
                 self.drift.reset()
@@ -313,7 +315,8 @@ class TargetChooser:
                 tempo = self.tempo_control.catching_up_tempo(tempo, distance, ahead_of_target_s)
         if not self._levelling:
             tempo = self.tempo_control.diving_tempo(tempo, float(position[2] - target[2]))
-        yaw = wanted_yaw(att, position, target, self.gains)
+        yaw = wanted_yaw(att, position, target, self.gains, self._last_error_rad)
+        self._last_error_rad = yaw / self.gains.yaw_fraction if self.gains.yaw_fraction else 0.0
         near = (distance < self.tempo_control.glide_within_m
                 and (not foresight or ahead_of_target_s > self.lead.glide_ahead_s))
         glide = ((near or (waiting and self.tempo_control.glide_within_m > 0))

@@ -18,6 +18,13 @@ from layered_swim.state import BodyState, lying
 FORWARD_LOCAL = {"prone": np.array([0.0, 0.0, 1.0]), "supine": np.array([0.0, 0.0, 1.0]),
                  "upright": np.array([1.0, 0.0, 0.0])}
 LATERAL_LOCAL = np.array([0.0, 1.0, 0.0])
+# The side of a lying body that faces the floor: the belly prone, the back supine.
+DOWN_LOCAL = {"prone": np.array([1.0, 0.0, 0.0]), "supine": np.array([-1.0, 0.0, 0.0])}
+# Nose up beyond this (standing up from treading water), a lying body's heading can be read off
+# where it would lie down.
+STEEP_PITCH_RAD = math.radians(60.0)
+# A target this close to dead behind keeps the turn going the way it went.
+KEEP_TURNING_RAD = math.radians(45.0)
 
 
 def wrap_angle(a: float) -> float:
@@ -50,14 +57,26 @@ def elevation(forward: np.ndarray) -> float:
     return math.asin(max(-1.0, min(1.0, float(forward[2]))))
 
 
-def attitude(pelvis_quat: np.ndarray, thorax_quat: np.ndarray, posture: str) -> Attitude:
+def attitude(pelvis_quat: np.ndarray, thorax_quat: np.ndarray, posture: str, facing: bool = False) -> Attitude:
+    """``facing``: a lying body pitched up beyond ``STEEP_PITCH_RAD`` heads where it would lie down
+    (for a stroke setting off standing; swimming, the butterfly and a breaststroke climbing to
+    the surface pitch up that far for a moment and keep their heading)."""
     forward = forward_axis(pelvis_quat, posture)
-    return Attitude(math.atan2(forward[1], forward[0]), elevation(forward), shoulder_roll(thorax_quat))
+    pitch = elevation(forward)
+    along = forward
+    if facing and lying(posture) and pitch > STEEP_PITCH_RAD:
+        # Nearly upright, the long axis points up and its heading is noise (it flipped 180 deg in a
+        # second as the breaststroke set off from treading water, which then turned the long way
+        # round); such a body lies down toward the side facing the floor: the long axis rotated
+        # level through it.
+        down = quat_rotate(np.asarray(pelvis_quat, float), DOWN_LOCAL[posture])
+        along = forward * math.cos(pitch) + down * math.sin(pitch)
+    return Attitude(math.atan2(along[1], along[0]), pitch, shoulder_roll(thorax_quat))
 
 
-def attitude_of(state: BodyState, posture: str) -> Attitude:
+def attitude_of(state: BodyState, posture: str, facing: bool = False) -> Attitude:
     """The swimmer's heading, pitch and shoulder roll now."""
-    return attitude(state.quat("pelvis"), state.quat("thorax"), posture)
+    return attitude(state.quat("pelvis"), state.quat("thorax"), posture, facing)
 
 
 @dataclass(frozen=True)
@@ -86,12 +105,19 @@ class MeanAttitude:
 
 
 def wanted_yaw(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,
-               gains: SteeringGains = SteeringGains()) -> float:
-    """The signed heading turn wanted this cycle (+ left)."""
+               gains: SteeringGains = SteeringGains(), last_error_rad: float = 0.0) -> float:
+    """The signed heading turn wanted this cycle (+ left). ``last_error_rad``: the last cycle's
+    heading error, as steered; a target that was and still is within ``KEEP_TURNING_RAD`` of dead
+    behind is turned to the same side as then, not the side the last degree of error now says
+    (flipping each cycle, the breaststroke swam 10 s straight away from a jump behind it)."""
     delta = np.asarray(target_m, float) - np.asarray(position_m, float)
     if math.hypot(delta[0], delta[1]) <= 1e-6:
         return 0.0
-    return gains.yaw_fraction * wrap_angle(math.atan2(delta[1], delta[0]) - att.heading_rad)
+    error = wrap_angle(math.atan2(delta[1], delta[0]) - att.heading_rad)
+    behind = math.pi - KEEP_TURNING_RAD
+    if last_error_rad * error < 0.0 and abs(last_error_rad) > behind and abs(error) > behind:
+        error -= math.copysign(2.0 * math.pi, error)
+    return gains.yaw_fraction * error
 
 
 def attitude_errors(mean: MeanAttitude, position_m: np.ndarray, target_m: np.ndarray, posture: str,
