@@ -12,7 +12,7 @@ of every cycle of the stroke swimming now, ``StrokeChoice`` looks at the target:
   stroke that holds a depth (the others ride the surface);
 - **reach**: a target that stays put farther than ``reach_beyond_m`` (a jump, a click) is swum to
   with the stroke that gets there soonest by its ``Ability`` (``soonest``), once the body swims
-  and heads toward it, until within ``reach_until_m``, where the approach and the hold take over
+  (``reach_from_m_s``), until within ``reach_until_m``, where the approach and the hold take over
   (alone, the breaststroke took up to 24 s to reach a jump 8-10 m away, the butterfly at most 11);
 - **sprint**: a moving target far ahead (``sprint_beyond_m``, within ``sprint_ahead_rad`` of the
   heading) is chased with the crawl, until it is near or off to the side (only far: from a
@@ -103,10 +103,10 @@ class StrokeChoice:
     # What a change of stroke costs in reaching: the blend and a first cycle from the last one's pose.
     switch_cost_s: float = 2.0
     # Only from a body already swimming this fast: from treading water, upright and still, the
-    # butterfly stalled nose-up and never got going; the breaststroke levels off first.
-    reach_from_m_s: float = 0.5
-    # ...heading within this of the target: slow, the butterfly stalled turning round (pitched up 77 deg).
-    reach_ahead_rad: float = math.radians(60.0)
+    # butterfly stalled nose-up and never got going; the breaststroke lays it down first. Slowest
+    # jump of `follow jumping --seeds 10` (median): 14.2 s; from 0.4 m/s 15.1, 0.5 15.8; from 0.3 the
+    # butterfly stalled in one run of ten and missed two stations.
+    reach_from_m_s: float = 0.35
     blend_s: float = 0.5
 
     def holds(self, active: str, distance_m: float, target_speed_m_s: float, closing_m_s: float = 0.0) -> bool:
@@ -130,8 +130,7 @@ class StrokeChoice:
         if abilities and ask.target_speed_m_s < self.still_m_s:
             soonest = self.soonest(active, ask, abilities)
             going_on = soonest == active and distance > self.reach_until_m
-            starting = (distance > self.reach_beyond_m and ask.speed_m_s >= self.reach_from_m_s
-                        and error < self.reach_ahead_rad)
+            starting = distance > self.reach_beyond_m and ask.speed_m_s >= self.reach_from_m_s
             if soonest != TURN and (going_on or starting):
                 return soonest
         if (distance > self.sprint_beyond_m and error < self.sprint_ahead_rad) or (
