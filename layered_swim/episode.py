@@ -245,10 +245,10 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                   depth_within_m=steer.depth_within_m,
                                   attitude_within_rad=math.radians(steer.attitude_within_deg),
                                   attitude_proportional=steer.attitude_proportional)
-            level_off = (math.radians(steer.level_off_beyond_deg)
-                         if LEVEL_OFF in stroke.perturbations and lying(stroke.start.posture) else None)
+            level_off = math.radians(steer.level_off_beyond_deg) if lying(stroke.start.posture) else None
             weights = TargetChooser(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,
                                     lead=lead, level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo,
+                                    level_off_sequence=LEVEL_OFF in stroke.perturbations,
                                     water=None if goal_line else water)
         else:
             weights = fixed_weights({}, tempo=tempo)

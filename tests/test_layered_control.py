@@ -709,6 +709,12 @@ def test_a_swimmer_starting_pitched_up_levels_off_instead_of_correcting_pitch():
                            level_off_tempo=1.2)
     assert behind(0, standing, None).tempo == 1.2
     assert behind(1, lying_state, None).tempo == pytest.approx(TempoControl().min_tempo)
+    # A stroke with no level-off sequence kicks at that tempo too, and corrects its pitch meanwhile.
+    plain = TargetChooser(FixedTarget((-5.0, 1.0, 0.0)), pitch_table, "prone", level_off_beyond_rad=math.radians(35.0),
+                          level_off_tempo=1.2, level_off_sequence=False)
+    first = plain(0, standing, None)
+    assert first.tempo == 1.2 and LEVEL_OFF not in first.weights and "pitch_down" in first.weights
+    assert plain(1, lying_state, None).tempo == pytest.approx(TempoControl().min_tempo)
 
 
 def test_a_level_off_sequence_leaves_the_calibration_valid():

@@ -252,16 +252,19 @@ class TargetChooser:
     def __init__(self, target: Target, table: CalibrationTable, posture: str,
                  gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead: Lead = Lead(),
                  level_off_beyond_rad: float | None = None, level_off_tempo: float = 1.0,
+                 level_off_sequence: bool = True,
                  water: Callable[[], Water] | None = None):
         """``level_off_beyond_rad``: starting (cycle 0) pitched nose up by more than this beyond
-        any climb toward the target, take the stroke's ``level_off`` sequence instead of a pitch
-        correction, at ``level_off_tempo``, every cycle until it is not (None: it has none).
+        any climb toward the target, swim at ``level_off_tempo`` every cycle until it is not (None:
+        never), taking the stroke's ``level_off`` sequence instead of a pitch correction where it
+        has one (``level_off_sequence``).
         ``water()``: the water swum in now; a target on a known path is then steered for in the
         frame of the water's steady current where the swimmer is (``InWater``)."""
         self.target, self.table, self.posture, self.lead = target, table, posture, lead
         self.water = water
         self.gains, self.tempo_control = gains, tempo
         self.level_off_beyond_rad, self.level_off_tempo = level_off_beyond_rad, level_off_tempo
+        self.level_off_sequence = level_off_sequence
         self._levelling = False
         self._last_error_rad = 0.0      # the last cycle's heading error, as steered
         self.held_rad = {"pitch": 0.0, "roll": 0.0}     # the attitude offsets the sequences hold
@@ -326,7 +329,7 @@ class TargetChooser:
             weights = self.table.weights_for(yaw, tempo) | self._attitude_weights(mean, position, target, tempo)
         if abs(yaw) > self.gains.over_weight_within_rad:
             weights = {name: min(1.0, w) for name, w in weights.items()}
-        if self._levelling:
+        if self._levelling and self.level_off_sequence:
             weights[LEVEL_OFF] = 1.0
         # Near the target, or turning hard, the rules stop seeking more thrust (Yang 4.4: more force
         # only where more is wanted); else they speed the swimmer past a slow target.
@@ -350,7 +353,7 @@ class TargetChooser:
         fractions = {"pitch": self.gains.pitch_fraction, "roll": self.gains.roll_fraction}
         weights = {}
         for axis, error in errors.items():
-            if fractions[axis] > 0.0 and not (axis == "pitch" and self._levelling):
+            if fractions[axis] > 0.0 and not (axis == "pitch" and self._levelling and self.level_off_sequence):
                 low, high = self.table.attitude_range(axis, tempo)
                 within = self.gains.attitude_within_rad
                 self.held_rad[axis] = held_offset(self.held_rad[axis], error, fractions[axis], low, high, within)

@@ -143,9 +143,9 @@ class SteeringSpec(Strict):
     over_weight_within_deg: float = Field(180.0, gt=0.0, le=180.0)
     # The tempo falls from full with the target 30 deg off the heading to min_tempo this far off.
     wide_turn_deg: float = Field(90.0, gt=30.0, le=180.0)
-    # Starting pitched nose up by more than this beyond any climb toward the target, a lying
-    # stroke with a ``level_off`` sequence takes it instead of correcting pitch until it lies
-    # (standing, a pitch correction does little).
+    # Starting pitched nose up by more than this beyond any climb toward the target (standing up
+    # from treading water), a lying stroke swims at level_off_tempo until it lies, taking its
+    # ``level_off`` sequence, where it has one, instead of correcting pitch.
     level_off_beyond_deg: float = Field(35.0, gt=0.0, le=90.0)
     level_off_tempo: float = Field(1.0, ge=0.1, le=1.5)    # the tempo of those level-off cycles
     breathe: bool = False           # breathe out to sink and in to rise toward the target's depth
