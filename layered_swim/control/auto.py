@@ -104,8 +104,9 @@ class StrokeChoice:
     switch_cost_s: float = 2.0
     # Only from a body already swimming this fast: from treading water, upright and still, the
     # butterfly stalled nose-up and never got going; the breaststroke lays it down first. Slowest
-    # jump of `follow jumping --seeds 10` (median): 14.2 s; from 0.4 m/s 15.1, 0.5 15.8; from 0.3 the
-    # butterfly stalled in one run of ten and missed two stations.
+    # jump of `follow jumping --seeds 10` (median, the breaststroke levelling off at tempo 1.0):
+    # 14.2 s; from 0.4 m/s 15.1, 0.5 15.8; from 0.3 the butterfly stalled in one run of ten and
+    # missed two stations.
     reach_from_m_s: float = 0.35
     blend_s: float = 0.5
 
