@@ -255,7 +255,8 @@ class AutoStrokeController:
         heading = attitude_of(state, self.current.stroke.start.posture).heading_rad
         ask = Ask(float(np.linalg.norm(goal - position)), target_speed_m_s(self.target, state.time_s),
                   bearing_error(position, goal, heading), self._asked_m_s(state.time_s, position),
-                  self.medium().surface_z_m - float(goal[2]), self._speed_m_s(state), self._closing_m_s(state))
+                  self.medium().surface_z_m - float(goal[2]),
+                  self._through_water_m_s(state.com_vel_m_s, position, state.time_s), closing_m_s(state, goal))
         return self.choice_rule.choose(self.active, ask, self.abilities)
 
     def _asked_m_s(self, time_s: float, position_m: np.ndarray) -> float:
@@ -264,17 +265,12 @@ class AutoStrokeController:
         velocity = target_velocity_m_s(self.target, time_s)
         if np.linalg.norm(velocity) > self.choice_rule.jumped_beyond_m_s:
             velocity = np.zeros(3)
-        velocity = velocity - self.medium().current_at(position_m, time_s, waves=False)[0]
-        return float(np.hypot(velocity[0], velocity[1]))
+        return self._through_water_m_s(velocity, position_m, time_s)
 
-    def _speed_m_s(self, state: BodyState) -> float:
-        velocity = state.com_vel_m_s - self.medium().current_at(state.com_m, state.time_s, waves=False)[0]
+    def _through_water_m_s(self, velocity_m_s: np.ndarray, position_m: np.ndarray, time_s: float) -> float:
+        """The horizontal speed of ``velocity_m_s`` less the water's at ``position_m``."""
+        velocity = velocity_m_s - self.medium().current_at(position_m, time_s, waves=False)[0]
         return float(np.hypot(velocity[0], velocity[1]))
-
-    def _closing_m_s(self, state: BodyState) -> float:
-        away = self.target.position(state.time_s)[:2] - state.com_m[:2]
-        distance_m = float(np.linalg.norm(away))
-        return float(state.com_vel_m_s[:2] @ away) / distance_m if distance_m > 1e-9 else 0.0
 
     def _hold_changes_now(self, state: BodyState) -> bool:
         """Whether holding should start or end now, mid-cycle: a still target come within reach is
@@ -282,9 +278,10 @@ class AutoStrokeController:
         between its cycle ends), and a held target that jumps away is left at once."""
         if self._from_pose is not None:
             return False
-        distance_m = float(np.linalg.norm(self.target.position(state.time_s) - state.com_m))
+        goal = self.target.position(state.time_s)
+        distance_m = float(np.linalg.norm(goal - state.com_m))
         holds = self.choice_rule.holds(self.active, distance_m, target_speed_m_s(self.target, state.time_s),
-                                       self._closing_m_s(state))
+                                       closing_m_s(state, goal))
         return holds != (self.active == HOLD)
 
     def _switch(self, name: str, time_s: float) -> None:
@@ -295,3 +292,10 @@ class AutoStrokeController:
         if self.current.lung_air_l is not None and self.lung_air_l is not None:
             self.current.lung_air_l = self.lung_air_l        # the breath held goes on
         self.switches.append(Switch(time_s, name))
+
+
+def closing_m_s(state: BodyState, goal_m: np.ndarray) -> float:
+    """How fast the swimmer nears ``goal_m``, horizontally, over the ground."""
+    away = goal_m[:2] - state.com_m[:2]
+    distance_m = float(np.linalg.norm(away))
+    return float(state.com_vel_m_s[:2] @ away) / distance_m if distance_m > 1e-9 else 0.0

@@ -30,7 +30,7 @@ from layered_swim.control.steering import (
     beyond,
     glide_pitch,
     held_offset,
-    wanted_yaw,
+    turn_error,
 )
 from layered_swim.control.stroke import LEVEL_OFF
 from layered_swim.control.targets import Target, target_speed_m_s
@@ -318,8 +318,8 @@ class TargetChooser:
                 tempo = self.tempo_control.catching_up_tempo(tempo, distance, ahead_of_target_s)
         if not self._levelling:
             tempo = self.tempo_control.diving_tempo(tempo, float(position[2] - target[2]))
-        yaw = wanted_yaw(att, position, target, self.gains, self._last_error_rad)
-        self._last_error_rad = yaw / self.gains.yaw_fraction if self.gains.yaw_fraction else 0.0
+        self._last_error_rad = turn_error(att, position, target, self._last_error_rad)
+        yaw = self.gains.yaw_fraction * self._last_error_rad
         near = (distance < self.tempo_control.glide_within_m
                 and (not foresight or ahead_of_target_s > self.lead.glide_ahead_s))
         glide = ((near or (waiting and self.tempo_control.glide_within_m > 0))

@@ -104,20 +104,25 @@ class MeanAttitude:
     roll_rad: float
 
 
-def wanted_yaw(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,
-               gains: SteeringGains = SteeringGains(), last_error_rad: float = 0.0) -> float:
-    """The signed heading turn wanted this cycle (+ left). ``last_error_rad``: the last cycle's
-    heading error, as steered; a target that was and still is within ``KEEP_TURNING_RAD`` of dead
-    behind is turned to the same side as then, not the side the last degree of error now says
-    (flipping each cycle, the breaststroke swam 10 s straight away from a jump behind it)."""
+def turn_error(att: Attitude, position_m: np.ndarray, target_m: np.ndarray, last_error_rad: float = 0.0) -> float:
+    """The signed heading error to turn away this cycle (+ left). ``last_error_rad``: the last
+    cycle's, as steered; a target that was and still is within ``KEEP_TURNING_RAD`` of dead behind
+    is turned to the same side as then, not the side the last degree of error now says (flipping
+    each cycle, the breaststroke swam 10 s straight away from a jump behind it)."""
     delta = np.asarray(target_m, float) - np.asarray(position_m, float)
     if math.hypot(delta[0], delta[1]) <= 1e-6:
         return 0.0
-    error = wrap_angle(math.atan2(delta[1], delta[0]) - att.heading_rad)
+    error = bearing_error(position_m, target_m, att.heading_rad)
     behind = math.pi - KEEP_TURNING_RAD
     if last_error_rad * error < 0.0 and abs(last_error_rad) > behind and abs(error) > behind:
         error -= math.copysign(2.0 * math.pi, error)
-    return gains.yaw_fraction * error
+    return error
+
+
+def wanted_yaw(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,
+               gains: SteeringGains = SteeringGains(), last_error_rad: float = 0.0) -> float:
+    """The signed heading turn wanted this cycle (+ left): ``yaw_fraction`` of the ``turn_error``."""
+    return gains.yaw_fraction * turn_error(att, position_m, target_m, last_error_rad)
 
 
 def attitude_errors(mean: MeanAttitude, position_m: np.ndarray, target_m: np.ndarray, posture: str,
