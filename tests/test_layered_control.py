@@ -21,7 +21,7 @@ from layered_swim.control.steering import (
     attitude_of,
     glide_pitch,
     held_offset,
-    wanted_yaw,
+    turn_error,
 )
 from layered_swim.control.stroke import (
     LEVEL_OFF,
@@ -117,10 +117,10 @@ def test_held_offset_integrates_the_error_within_what_the_sequences_hold():
     assert all(e < 0 for e in errors) and abs(errors[-1]) < 1e-3 * abs(errors[0])
 
 
-def test_wanted_yaw_and_attitude_errors_from_target_position():
+def test_turn_error_and_attitude_errors_from_target_position():
     facing_x = Attitude(heading_rad=0.0, pitch_rad=0.0, roll_rad=0.0)
-    assert wanted_yaw(facing_x, np.zeros(3), np.array([0.0, 5.0, 0.0])) > 0        # target on the left: turn left
-    assert wanted_yaw(facing_x, np.zeros(3), np.array([0.0, -5.0, 0.0])) < 0
+    assert turn_error(facing_x, np.zeros(3), np.array([0.0, 5.0, 0.0])) > 0        # target on the left: turn left
+    assert turn_error(facing_x, np.zeros(3), np.array([0.0, -5.0, 0.0])) < 0
     level = MeanAttitude(math.radians(8.0), 0.0)
     flat = attitude_errors(MeanAttitude(math.radians(8.0), 0.0), np.zeros(3), np.array([5.0, 0, 0]), "prone", level)
     assert flat == pytest.approx({"roll": 0.0, "pitch": 0.0})          # the stroke's own attitude at the target's depth
@@ -138,16 +138,15 @@ def test_wanted_yaw_and_attitude_errors_from_target_position():
 def test_a_target_dead_behind_is_turned_to_the_side_the_turn_already_goes():
     """Noise of a degree either side of dead behind flips the shorter side; a turn under way keeps
     its side there, but a target newly behind (a jump) is turned to the shorter side."""
-    gains = SteeringGains(yaw_fraction=0.5)
     facing_x = Attitude(heading_rad=0.0, pitch_rad=0.0, roll_rad=0.0)
     behind_right = np.array([-5.0, -0.2, 0.0])          # 177.7 deg to the right
     error = -math.pi + math.atan2(0.2, 5.0)
-    assert wanted_yaw(facing_x, np.zeros(3), behind_right, gains) == pytest.approx(0.5 * error)
-    assert wanted_yaw(facing_x, np.zeros(3), behind_right, gains, last_error_rad=math.radians(170.0)) == (
-        pytest.approx(0.5 * (error + 2 * math.pi)))          # was turning left round to it: on left
+    assert turn_error(facing_x, np.zeros(3), behind_right) == pytest.approx(error)
+    assert turn_error(facing_x, np.zeros(3), behind_right, last_error_rad=math.radians(170.0)) == (
+        pytest.approx(error + 2 * math.pi))          # was turning left round to it: on left
     for last_deg in (20.0, -170.0):                        # not behind then, or already on the right
-        assert wanted_yaw(facing_x, np.zeros(3), behind_right, gains,
-                          last_error_rad=math.radians(last_deg)) == pytest.approx(0.5 * error)
+        assert turn_error(facing_x, np.zeros(3), behind_right,
+                          last_error_rad=math.radians(last_deg)) == pytest.approx(error)
 
 
 def _pitched_up(base_quat, pitch_deg: float, heading_deg: float) -> np.ndarray:

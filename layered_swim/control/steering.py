@@ -119,12 +119,6 @@ def turn_error(att: Attitude, position_m: np.ndarray, target_m: np.ndarray, last
     return error
 
 
-def wanted_yaw(att: Attitude, position_m: np.ndarray, target_m: np.ndarray,
-               gains: SteeringGains = SteeringGains(), last_error_rad: float = 0.0) -> float:
-    """The signed heading turn wanted this cycle (+ left): ``yaw_fraction`` of the ``turn_error``."""
-    return gains.yaw_fraction * turn_error(att, position_m, target_m, last_error_rad)
-
-
 def attitude_errors(mean: MeanAttitude, position_m: np.ndarray, target_m: np.ndarray, posture: str,
                     level: MeanAttitude, gains: SteeringGains = SteeringGains()) -> dict[str, float]:
     """How far the cycle's mean attitude is from the wanted one (+: more nose up, more left shoulder
