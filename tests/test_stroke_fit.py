@@ -1,6 +1,7 @@
 """fit-stroke: the knobs set the stroke's numbers as named, the score counts only what misses,
 bad fit files are one line, and a short search runs, resumes and repeats."""
 import json
+import math
 import os
 import subprocess
 import sys
@@ -10,6 +11,7 @@ import pytest
 import yaml
 
 from layered_swim.analysis import stroke_fit
+from layered_swim.analysis.calibrate import calibration_swim
 from layered_swim.analysis.stroke_fit import FitSpec, Target, apply_knobs, load_fit, score
 from layered_swim.config import ConfigError
 
@@ -44,6 +46,23 @@ def test_perturbation_knobs_set_a_sequence_s_offsets_and_scale_them_about_zero(t
                                     knobs={"yaw_left/elbow_l.flexion[1]": {"min": 0, "max": 60}}))
     assert spec.needs_turns() and not spec.needs_towing()
 
+
+
+def test_a_yaw_sequence_s_turning_circle_is_its_distance_a_cycle_over_its_turn_a_cycle():
+    """The distance a cycle follows the track cycle by cycle: swimming straight it is the speed
+    times the period; turning, the chord of the measured turn (two cycles of it) is shorter than
+    its arc by sin(x)/x; the radius is that distance over the turn a cycle."""
+    period_s = 1.517                                                 # strokes/breaststroke.yaml
+    drift, speed_m_s, *_, straight_m = calibration_swim(("breaststroke", None, 0.0, 1.0))
+    assert straight_m == pytest.approx(speed_m_s * period_s, rel=0.01)
+    change, chord_speed_m_s, *_, turning_m = calibration_swim(("breaststroke", "yaw_left", 1.0, 1.0))
+    turn_rad = change - drift[0]
+    assert turn_rad > 0.3 and turning_m < straight_m                  # a full turn slows it
+    assert chord_speed_m_s * period_s == pytest.approx(turning_m * math.sin(turn_rad) / turn_rad, rel=0.02)
+    turns = stroke_fit.turns_deg_per_s("breaststroke", period_s)
+    assert turns["yaw_left_radius_m"] == pytest.approx(turning_m / turn_rad)
+    assert turns["yaw_left_deg_per_s"] == pytest.approx(math.degrees(turn_rad) / period_s)
+    assert set(turns) == {"yaw_left_deg_per_s", "yaw_right_deg_per_s", "yaw_left_radius_m", "yaw_right_radius_m"}
 
 def test_rest_knobs_set_a_held_angle_only_where_no_key_sets_it(tmp_path):
     out = apply_knobs(STROKE, {"rest.neck.flexion": -30.0})

@@ -32,12 +32,13 @@ MEASURE_CYCLES = 2
 
 class _CycleAttitude:
     """Observer: per stroke cycle, the unwrapped heading, pitch and roll at every control step,
-    and the centre of mass once the perturbation is on."""
+    and the centre of mass once the perturbation is on (every control step, and as each cycle starts)."""
 
     def __init__(self, episode: Episode):
         self.controller, self.posture = episode.controller, episode.stroke.start.posture
         self.samples: dict[int, list[tuple[float, float, float]]] = {}
         self.positions: list[np.ndarray] = []
+        self.cycle_starts_m: dict[int, np.ndarray] = {}
         self._heading_prev, self._unwrapped = None, 0.0
 
     def __call__(self, sim) -> None:
@@ -51,12 +52,15 @@ class _CycleAttitude:
         self.samples.setdefault(cycle, []).append((self._unwrapped, att.pitch_rad, att.roll_rad))
         if cycle >= SETTLE_CYCLES:
             self.positions.append(sim.state.com_m)
+            self.cycle_starts_m.setdefault(cycle, sim.state.com_m)
 
 
 def calibration_swim(job: tuple[str, str | None, float, float]) -> tuple:
     """One calibration swim: (angle change per cycle about the sequence's axis, mean speed, the
-    last cycle's mean roll and pitch, the final depth of the centre of mass); with no sequence
-    the change is (yaw, pitch, roll)."""
+    last cycle's mean roll and pitch, the final depth of the centre of mass, the distance swum per
+    cycle along the track); with no sequence the change is (yaw, pitch, roll). The speed is the
+    track's chord over the time (a turn's shortens it); the distance follows the turn, cycle by
+    cycle."""
     stroke_name, sequence, weight, tempo = job
     weights = {sequence: weight} if sequence else {}
     episode = Episode(stroke_name, weights=fixed_weights(weights, SETTLE_CYCLES, tempo),
@@ -74,8 +78,10 @@ def calibration_swim(job: tuple[str, str | None, float, float]) -> tuple:
     change = (after - before) / MEASURE_CYCLES
     track = np.array(attitude.positions)
     speed = float(np.linalg.norm(track[-1, :2] - track[0, :2]) / (len(track) / control_hz))
+    ends = [attitude.cycle_starts_m[c][:2] for c in sorted(attitude.cycle_starts_m)] + [track[-1, :2]]
+    per_cycle_m = float(sum(np.linalg.norm(b - a) for a, b in zip(ends, ends[1:]))) / MEASURE_CYCLES
     return ((float(change[axis]) if sequence else change.tolist()), speed, float(after[2]),
-            float(after[1]), float(-track[-1, 2]))
+            float(after[1]), float(-track[-1, 2]), per_cycle_m)
 
 
 def weight_grid(max_weight: float) -> tuple[float, ...]:

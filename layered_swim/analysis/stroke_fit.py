@@ -19,7 +19,9 @@ A fit file (YAML) names the stroke, the ranges to reach (``targets``: any figure
   sequence SEQ's keys (offsets, degrees; ``:scale`` multiplies them, about 0), e.g.
   ``yaw_left/elbow_l.flexion[1]``; with the targets
   ``yaw_left_deg_per_s``/``yaw_right_deg_per_s`` (each yaw sequence's turn at full weight, as
-  ``calibrate`` measures it) the search re-tunes the steering's turns for a changed stroke;
+  ``calibrate`` measures it) the search re-tunes the steering's turns for a changed stroke, and
+  with ``yaw_left_radius_m``/``yaw_right_radius_m`` (the radius of the circle it swims there) for
+  tighter ones;
 - ``rest.JOINT.AXIS``: the rest pose's angle (degrees) of a coordinate no key sets (held all
   cycle: the head's or the back's carriage).
 
@@ -62,7 +64,8 @@ BEST_STROKE = "best.yaml"
 BEST = "best.json"
 RESOLVED = "fit.json"
 NOT_MEASURED_PENALTY = 100.0        # a candidate that blew up, did not cycle, or lacks a targeted figure
-TURNS = ("yaw_left_deg_per_s", "yaw_right_deg_per_s")     # each yaw sequence at weight 1, tempo 1
+# Each yaw sequence at weight 1, tempo 1: how fast it turns, and how tight (the radius of its circle).
+TURNS = ("yaw_left_deg_per_s", "yaw_right_deg_per_s", "yaw_left_radius_m", "yaw_right_radius_m")
 FIGURES = (*QUANTITIES, "active_drag_x_narita", *TURNS)
 REST = re.compile(r"^rest\.(?P<joint>\w+)\.(?P<axis>\w+)$")
 KNOB = re.compile(r"^(?:(?P<seq>\w+)/)?(?P<joint>\w+)\.(?P<axis>\w+)(?:\[(?P<index>\d+)\])?"
@@ -334,13 +337,15 @@ def swim_candidate(job: dict) -> dict:
 def turns_deg_per_s(path: str, period_s: float) -> dict[str, float]:
     """How fast each yaw sequence turns the swimmer at full weight and tempo 1, as ``calibrate``
     measures it (its turn per cycle less the unperturbed drift), per second: a slower stroke
-    turns less often, and steering needs turns per second."""
+    turns less often, and steering needs turns per second; and how tight: the radius of the
+    circle it swims (distance per cycle over turn per cycle; None where it turns the other way)."""
     drift = calibration_swim((path, None, 0.0, 1.0))[0][AXIS_INDEX["yaw"]]
     out = {}
-    for name in TURNS:
-        sequence = name.removesuffix("_deg_per_s")
-        sign = SEQUENCE_AXIS[sequence][1]
-        out[name] = math.degrees(sign * (calibration_swim((path, sequence, 1.0, 1.0))[0] - drift)) / period_s
+    for sequence in ("yaw_left", "yaw_right"):
+        change, *_, per_cycle_m = calibration_swim((path, sequence, 1.0, 1.0))
+        turn_rad = SEQUENCE_AXIS[sequence][1] * (change - drift)
+        out[f"{sequence}_deg_per_s"] = math.degrees(turn_rad) / period_s
+        out[f"{sequence}_radius_m"] = per_cycle_m / turn_rad if turn_rad > 0.0 else None
     return out
 
 
