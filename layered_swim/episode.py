@@ -246,10 +246,13 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                   attitude_within_rad=math.radians(steer.attitude_within_deg),
                                   attitude_proportional=steer.attitude_proportional)
             level_off = math.radians(steer.level_off_beyond_deg) if lying(stroke.start.posture) else None
+            recover = (None, None) if goal_line else tuple(
+                None if deg is None else math.radians(deg)
+                for deg in (steer.recover_beyond_pitch_deg, steer.recover_beyond_roll_deg))
             weights = TargetChooser(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,
                                     lead=lead, level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo,
                                     level_off_sequence=LEVEL_OFF in stroke.perturbations,
-                                    water=None if goal_line else water)
+                                    recover_beyond_rad=recover, water=None if goal_line else water)
         else:
             weights = fixed_weights({}, tempo=tempo)
     lungs = (LungControl(body.lung_air_l, body.max_lung_air_l, breathe_out=stroke.steering.breathe_out)

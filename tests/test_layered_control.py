@@ -37,8 +37,9 @@ from layered_swim.control.stroke import (
 from layered_swim.control.targets import FixedTarget, TrajectoryTarget, load_trajectory
 from layered_swim.episode import Episode
 from layered_swim.geometry import quat_multiply
+from layered_swim.runs import swim
 from layered_swim.sim.simulation import PRONE_QUAT_XYZW, SUPINE_QUAT_XYZW
-from layered_swim.spec import GOAL_TEMPO
+from layered_swim.spec import GOAL_TEMPO, SwimSpec
 from layered_swim.state import BodyState, Segments
 from layered_swim.tasks import FollowTarget
 
@@ -715,6 +716,39 @@ def test_a_swimmer_starting_pitched_up_levels_off_instead_of_correcting_pitch():
     assert first.tempo == 1.2 and LEVEL_OFF not in first.weights and "pitch_down" in first.weights
     assert plain(1, lying_state, None).tempo == pytest.approx(TempoControl().min_tempo)
 
+
+
+def test_a_stroke_that_stood_up_or_rolled_over_mid_swim_swims_a_plain_cycle_at_its_level_off_tempo():
+    """After a cycle whose mean pitch or shoulder roll went past the stroke's limits, the next
+    cycle takes no sequence at all and runs at the level-off tempo; the held offsets wait; within
+    the limits (or with none set) it steers as before."""
+    pitch_table = table()
+    pitch_table.attitude_rad["pitch_down"] = -pitch_table.turn_rad["yaw_left"]
+    state = still_state(np.full(16, 1 / 16))
+    chooser = TargetChooser(FixedTarget((5.0, 1.0, 0.0)), pitch_table, "prone", gains=SteeringGains(pitch_fraction=0.5),
+                            level_off_tempo=1.2, recover_beyond_rad=(math.radians(25.0), math.radians(30.0)))
+    level = MeanAttitude(math.radians(10.0), math.radians(5.0))
+    steered = chooser(1, state, MeanAttitude(math.radians(20.0), 0.0))
+    assert steered.weights["yaw_left"] > 0 and "pitch_down" in steered.weights and steered.tempo == 1.0
+    held = dict(chooser.held_rad)
+    for stood_or_rolled in (MeanAttitude(math.radians(30.0), 0.0), MeanAttitude(0.0, math.radians(-35.0))):
+        plain = chooser(2, state, stood_or_rolled)
+        assert plain.weights == {} and plain.tempo == 1.2 and not plain.glide
+        assert chooser.held_rad == held
+    assert chooser(3, state, level).weights["yaw_left"] > 0
+    never = TargetChooser(FixedTarget((5.0, 1.0, 0.0)), pitch_table, "prone", level_off_tempo=1.2)
+    assert never(2, state, MeanAttitude(math.radians(60.0), math.radians(60.0))).weights["yaw_left"] > 0
+
+
+def test_the_backstroke_waiting_for_a_slow_target_rights_itself_instead_of_stalling():
+    """Its slowest tempo swims 0.9 m/s: ahead of the straight line's 0.5 m/s target it turns back
+    at that tempo and stands up; without the recovery it stalled there with every sequence at full
+    weight and fell ever further behind (18-22 m after 90 s, seeds 1-3; with it 3-8 m)."""
+    spec = SwimSpec.of("t", stroke="backstroke", task={"kind": "follow", "trajectory": "straight_line"},
+                       seconds=90.0, seed=1)
+    track = swim(spec.episode(), 90.0).task.track()
+    distance = np.linalg.norm(track["swimmer_m"] - track["target_m"], axis=1)
+    assert distance[track["track_time_s"] > 60.0].max() < 10.0
 
 def test_a_level_off_sequence_leaves_the_calibration_valid():
     """Calibration swims lying down, where the level-off is never taken: adding one leaves the

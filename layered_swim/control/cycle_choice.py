@@ -252,12 +252,15 @@ class TargetChooser:
     def __init__(self, target: Target, table: CalibrationTable, posture: str,
                  gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead: Lead = Lead(),
                  level_off_beyond_rad: float | None = None, level_off_tempo: float = 1.0,
-                 level_off_sequence: bool = True,
+                 level_off_sequence: bool = True, recover_beyond_rad: tuple[float | None, float | None] = (None, None),
                  water: Callable[[], Water] | None = None):
         """``level_off_beyond_rad``: starting (cycle 0) pitched nose up by more than this beyond
         any climb toward the target, swim at ``level_off_tempo`` every cycle until it is not (None:
         never), taking the stroke's ``level_off`` sequence instead of a pitch correction where it
         has one (``level_off_sequence``).
+        ``recover_beyond_rad``: (pitch, roll); after a cycle whose mean pitch was more than the first
+        nose up, or whose mean shoulder roll was more than the second either way, swim a plain
+        cycle at ``level_off_tempo`` (None: never).
         ``water()``: the water swum in now; a target on a known path is then steered for in the
         frame of the water's steady current where the swimmer is (``InWater``)."""
         self.target, self.table, self.posture, self.lead = target, table, posture, lead
@@ -265,6 +268,7 @@ class TargetChooser:
         self.gains, self.tempo_control = gains, tempo
         self.level_off_beyond_rad, self.level_off_tempo = level_off_beyond_rad, level_off_tempo
         self.level_off_sequence = level_off_sequence
+        self.recover_beyond_rad = recover_beyond_rad
         self._levelling = False
         self._last_error_rad = 0.0      # the last cycle's heading error, as steered
         self.held_rad = {"pitch": 0.0, "roll": 0.0}     # the attitude offsets the sequences hold
@@ -324,6 +328,11 @@ class TargetChooser:
                 and (not foresight or ahead_of_target_s > self.lead.glide_ahead_s))
         glide = ((near or (waiting and self.tempo_control.glide_within_m > 0))
                  and abs(heading_error) < self.tempo_control.easy_turn_rad)
+        if self._stood_or_rolled(last_cycle):
+            # Turning slowly, the backstroke stood up or rolled onto its side and stalled there for
+            # tens of seconds with every sequence at full weight; a plain cycle at speed rights it
+            # (the held offsets wait, as through a glide).
+            return CycleChoice({}, self.level_off_tempo, thrust_demand=drive)
         weights = {}        # a glide holds its first pose: no sequence, and the held offsets wait
         if not glide:
             weights = self.table.weights_for(yaw, tempo) | self._attitude_weights(mean, position, target, tempo)
@@ -335,6 +344,13 @@ class TargetChooser:
         # only where more is wanted); else they speed the swimmer past a slow target.
         return CycleChoice(weights, tempo, glide, self.tempo_control.glide_cycles if glide else 1.0,
                            thrust_demand=drive)
+
+    def _stood_or_rolled(self, last_cycle: MeanAttitude | None) -> bool:
+        """Whether the last cycle's mean attitude was past ``recover_beyond_rad``."""
+        pitch_rad, roll_rad = self.recover_beyond_rad
+        return last_cycle is not None and (
+            (pitch_rad is not None and last_cycle.pitch_rad > pitch_rad)
+            or (roll_rad is not None and abs(last_cycle.roll_rad) > roll_rad))
 
     def _current_m_s(self, position_m: np.ndarray, time_s: float) -> np.ndarray:
         """The water's steady horizontal velocity at ``position_m`` (zero with no water to read)."""

@@ -148,6 +148,11 @@ class SteeringSpec(Strict):
     # ``level_off`` sequence, where it has one, instead of correcting pitch.
     level_off_beyond_deg: float = Field(35.0, gt=0.0, le=90.0)
     level_off_tempo: float = Field(1.0, ge=0.1, le=1.5)    # the tempo of those level-off cycles
+    # Mid-swim, after a cycle whose mean pitch was more than this nose up, or whose mean shoulder
+    # roll was more than recover_beyond_roll_deg either way, a plain cycle (no sequence) at
+    # level_off_tempo (none: never).
+    recover_beyond_pitch_deg: float | None = Field(None, gt=0.0, le=90.0)
+    recover_beyond_roll_deg: float | None = Field(None, gt=0.0, le=90.0)
     breathe: bool = False           # breathe out to sink and in to rise toward the target's depth
     # ... breathing out below the resting breath too (false: only in, to rise back from a push;
     # a crawl that emptied its lungs to dive sank legs first, nose up)
