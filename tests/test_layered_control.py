@@ -567,7 +567,6 @@ def test_a_swimmer_ahead_of_its_target_but_far_off_its_path_swims_back_instead_o
     assert off.thrust_demand > 0.0 and off.tempo > TempoControl().min_tempo
 
 
-
 def test_a_swimmer_ahead_of_a_diving_target_but_above_it_dives_on_instead_of_waiting():
     """With ``wait_depth_within_m`` a swimmer ahead of its target waits only near the depth it
     steers for: 1.5 m above it (the breaststroke rode up nose-first at its slowest tempo and lost
@@ -579,6 +578,7 @@ def test_a_swimmer_ahead_of_a_diving_target_but_above_it_dives_on_instead_of_wai
     assert TargetChooser(deep, table(), "prone")(0, state, None).thrust_demand == 0.0
     diving = TargetChooser(deep, table(), "prone", lead=Lead(wait_depth_within_m=0.5))(0, state, None)
     assert diving.thrust_demand > 0.0 and diving.tempo > TempoControl().min_tempo
+
 
 def test_drift_is_the_sideways_motion_over_a_cycle_and_a_steady_turn_has_none():
     drift, known = Drift(), Drift()
@@ -717,7 +717,6 @@ def test_a_swimmer_starting_pitched_up_levels_off_instead_of_correcting_pitch():
     assert plain(1, lying_state, None).tempo == pytest.approx(TempoControl().min_tempo)
 
 
-
 def test_a_stroke_that_stood_up_or_rolled_over_mid_swim_swims_a_plain_cycle_at_its_level_off_tempo():
     """After a cycle whose mean pitch or shoulder roll went past the stroke's limits, the next
     cycle takes no sequence at all and runs at the level-off tempo; the held offsets wait; within
@@ -749,6 +748,7 @@ def test_the_backstroke_waiting_for_a_slow_target_rights_itself_instead_of_stall
     track = swim(spec.episode(), 90.0).task.track()
     distance = np.linalg.norm(track["swimmer_m"] - track["target_m"], axis=1)
     assert distance[track["track_time_s"] > 60.0].max() < 10.0
+
 
 def test_a_level_off_sequence_leaves_the_calibration_valid():
     """Calibration swims lying down, where the level-off is never taken: adding one leaves the

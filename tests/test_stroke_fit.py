@@ -47,7 +47,6 @@ def test_perturbation_knobs_set_a_sequence_s_offsets_and_scale_them_about_zero(t
     assert spec.needs_turns() and not spec.needs_towing()
 
 
-
 def test_a_yaw_sequence_s_turning_circle_is_its_distance_a_cycle_over_its_turn_a_cycle():
     """The distance a cycle follows the track cycle by cycle: swimming straight it is the speed
     times the period; turning, the chord of the measured turn (two cycles of it) is shorter than
@@ -59,10 +58,11 @@ def test_a_yaw_sequence_s_turning_circle_is_its_distance_a_cycle_over_its_turn_a
     turn_rad = change - drift[0]
     assert turn_rad > 0.3 and turning_m < straight_m                  # a full turn slows it
     assert chord_speed_m_s * period_s == pytest.approx(turning_m * math.sin(turn_rad) / turn_rad, rel=0.02)
-    turns = stroke_fit.turns_deg_per_s("breaststroke", period_s)
+    turns = stroke_fit.full_weight_turns("breaststroke", period_s)
     assert turns["yaw_left_radius_m"] == pytest.approx(turning_m / turn_rad)
     assert turns["yaw_left_deg_per_s"] == pytest.approx(math.degrees(turn_rad) / period_s)
     assert set(turns) == {"yaw_left_deg_per_s", "yaw_right_deg_per_s", "yaw_left_radius_m", "yaw_right_radius_m"}
+
 
 def test_rest_knobs_set_a_held_angle_only_where_no_key_sets_it(tmp_path):
     out = apply_knobs(STROKE, {"rest.neck.flexion": -30.0})

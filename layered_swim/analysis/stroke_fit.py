@@ -322,7 +322,7 @@ def swim_candidate(job: dict) -> dict:
                                    plate=None if job["added_mass"] else {"added_mass": False})
             free = swim_measured({**base, "buoy_kg_m": None})
             towing = swim_measured({**base, "buoy_kg_m": job["buoy_kg_m"]}) if job["towing"] else None
-            turns = turns_deg_per_s(str(path), float(job["stroke"]["period_s"])) if job["turns"] else {}
+            turns = full_weight_turns(str(path), float(job["stroke"]["period_s"])) if job["turns"] else {}
         except (ConfigError, SimulationDiverged) as err:
             return {"error": str(err)}
     for swum in (free, towing):
@@ -334,7 +334,7 @@ def swim_candidate(job: dict) -> dict:
     return {"figures": {k: _plain(v) for k, v in {**figures, **turns}.items()}}
 
 
-def turns_deg_per_s(path: str, period_s: float) -> dict[str, float]:
+def full_weight_turns(path: str, period_s: float) -> dict[str, float | None]:
     """How fast each yaw sequence turns the swimmer at full weight and tempo 1, as ``calibrate``
     measures it (its turn per cycle less the unperturbed drift), per second: a slower stroke
     turns less often, and steering needs turns per second; and how tight: the radius of the
