@@ -9,7 +9,15 @@ from layered_swim.body.layout import joint_layout
 from layered_swim.body.model import load_body
 from layered_swim.config import ConfigError, load
 from layered_swim.control.calibration import CalibrationTable, Pace, load_table
-from layered_swim.control.cycle_choice import Drift, InWater, Lead, TargetChooser, TempoControl
+from layered_swim.control.cycle_choice import (
+    Drift,
+    InWater,
+    Lead,
+    TargetChooser,
+    TempoControl,
+    behind_along_m,
+    stays_at_surface,
+)
 from layered_swim.control.layered import CycleChoice, LayeredController, Layers, fixed_weights
 from layered_swim.control.rules import arm_indices, rule_offsets
 from layered_swim.control.steering import (
@@ -36,6 +44,7 @@ from layered_swim.control.stroke import (
 )
 from layered_swim.control.targets import FixedTarget, TrajectoryTarget, load_trajectory
 from layered_swim.episode import Episode
+from layered_swim.fluid.medium import Medium
 from layered_swim.geometry import quat_multiply
 from layered_swim.runs import swim
 from layered_swim.sim.simulation import PRONE_QUAT_XYZW, SUPINE_QUAT_XYZW
@@ -297,6 +306,37 @@ def test_far_behind_a_moving_target_swims_at_the_turn_tempo():
     assert TargetChooser(ahead_along_x, table(), "prone")(0, state, None).tempo == pytest.approx(1.0)
     jumped = FixedTarget((3.0, 0.0, 0.0))
     assert TargetChooser(jumped, table(), "prone", tempo=catching)(0, state, None).tempo == pytest.approx(1.0)
+
+
+def test_behind_a_moving_target_at_the_surface_a_stroke_closes_the_gap():
+    """With close_gap_s, a stroke behind a moving target swims at its pace plus the gap over
+    close_gap_s (the test table's pace: 0.4 m/s at tempo 0.5, 0.8 at 1.0), up to its turn tempo;
+    ahead of it, at its pace; without, at its pace alone; and not where the path dives."""
+    closing = TempoControl(close_gap_s=0.5)
+    assert closing.closing_speed_m_s(0.5, 0.1) == pytest.approx(0.7)
+    assert closing.closing_speed_m_s(0.5, -0.3) == pytest.approx(0.5)
+    assert TempoControl().closing_speed_m_s(0.5, 0.1) == pytest.approx(0.5)
+    along_x = TrajectoryTarget(np.array([[0.1, 0.0, 0.0], [30.1, 0.0, 0.0]]), np.array([0.0, 60.0]), 1.0, False)
+    assert behind_along_m(along_x, 0.0, np.zeros(3)) == pytest.approx(0.1)
+    assert behind_along_m(along_x, 0.0, np.array([5.1, 2.0, -1.0])) == pytest.approx(-5.0)
+    assert behind_along_m(FixedTarget((3.0, 0.0, 0.0)), 0.0, np.zeros(3)) == 0.0
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x, 0.1 m behind
+    assert TargetChooser(along_x, table(), "prone", tempo=closing)(0, state, None).tempo == pytest.approx(0.875)
+    assert TargetChooser(along_x, table(), "prone")(0, state, None).tempo == pytest.approx(0.625)
+    capped = TempoControl(close_gap_s=0.1, turn_tempo=0.8)
+    assert TargetChooser(along_x, table(), "prone", tempo=capped)(0, state, None).tempo == pytest.approx(0.8)
+    under_a_metre = Medium(surface_z_m=1.0)       # the swimmer and its target 1 m deep
+    deep = TargetChooser(along_x, table(), "prone", tempo=closing, water=lambda: under_a_metre)
+    assert deep(0, state, None).tempo == pytest.approx(0.625)
+
+
+def test_a_gap_is_closed_only_on_a_path_that_stays_at_the_surface():
+    """deep_dive runs 0.3 m deep for 10 s, dives to 4 m by 30 s, holds, climbs back by 60 s: near
+    the surface with a dive ahead, at depth, and climbing below 0.5 m, no; at the surface after, yes."""
+    dive = load_trajectory("deep_dive")
+    assert [stays_at_surface(dive, t, 0.0) for t in (0.0, 35.0, 50.0, 70.0)] == [False, False, False, True]
+    assert stays_at_surface(load_trajectory("straight_line"), 0.0, 0.0)
+    assert not stays_at_surface(load_trajectory("straight_line"), 0.0, 1.0)
 
 
 def test_diving_swims_at_least_at_the_dive_tempo():
