@@ -352,8 +352,7 @@ class TargetChooser:
         if self.tempo_control.keep_pace and not waiting and foresight:
             speed_m_s = target_speed_m_s(path, state.time_s + max(0.0, ahead_of_target_s), STEP_S)
             tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(speed_m_s)))
-            surface_z_m = self.water().surface_z_m if self.water is not None else 0.0
-            if self.tempo_control.close_gap_s is not None and stays_at_surface(path, state.time_s, surface_z_m):
+            if self.tempo_control.close_gap_s is not None and stays_at_surface(path, state.time_s, self._surface_z_m()):
                 closing = self.tempo_control.closing_speed_m_s(speed_m_s, behind_along_m(path, state.time_s, position))
                 fastest = self.tempo_control.turn_tempo or 1.0
                 tempo = max(tempo, min(fastest, self.table.pace.tempo_for_speed(closing)))
@@ -392,6 +391,9 @@ class TargetChooser:
         return last_cycle is not None and (
             (pitch_rad is not None and last_cycle.pitch_rad > pitch_rad)
             or (roll_rad is not None and abs(last_cycle.roll_rad) > roll_rad))
+
+    def _surface_z_m(self) -> float:
+        return self.water().surface_z_m if self.water is not None else 0.0
 
     def _current_m_s(self, position_m: np.ndarray, time_s: float) -> np.ndarray:
         """The water's steady horizontal velocity at ``position_m`` (zero with no water to read)."""
