@@ -253,6 +253,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
             weights = TargetChooser(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,
                                     lead=lead, level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo,
                                     level_off_sequence=LEVEL_OFF in stroke.perturbations,
+                                    level_off_pitch_down_weight=(None if goal_line
+                                                                 else steer.level_off_pitch_down_weight),
                                     recover_beyond_rad=recover, water=None if goal_line else water)
         else:
             weights = fixed_weights({}, tempo=tempo)

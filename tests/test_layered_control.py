@@ -757,6 +757,32 @@ def test_a_swimmer_starting_pitched_up_levels_off_instead_of_correcting_pitch():
     assert plain(1, lying_state, None).tempo == pytest.approx(TempoControl().min_tempo)
 
 
+def test_a_stroke_levels_off_with_its_pitch_down_sequence_overweighted_until_its_cycles_lie():
+    """With ``level_off_pitch_down_weight``, levelling off takes the pitch-down sequence at that
+    weight (not the correction's calibrated weights), and goes on while the last cycle's mean
+    pitch was still up, though the pitch dipped as the cycle began."""
+    from scipy.spatial.transform import Rotation
+
+    lying_state = still_state(np.full(16, 1 / 16))
+    nose_up = (Rotation.from_euler("y", -60.0, degrees=True) * Rotation.from_quat(PRONE_QUAT_XYZW)).as_quat()
+    standing = BodyState(0.0, np.zeros((16, 3)), np.tile(nose_up, (16, 1)), np.zeros((16, 3)), np.zeros((16, 3)),
+                         lying_state.segments)
+    pitch_table = table()
+    pitch_table.attitude_rad["pitch_down"] = -pitch_table.turn_rad["yaw_left"]
+    pitch_table.attitude_rad["pitch_up"] = pitch_table.turn_rad["yaw_left"]
+    chooser = TargetChooser(FixedTarget((5.0, 1.0, 0.0)), pitch_table, "prone", level_off_beyond_rad=math.radians(35.0),
+                            level_off_tempo=1.2, level_off_sequence=False, level_off_pitch_down_weight=2.5)
+    first = chooser(0, standing, None)
+    assert first.tempo == 1.2 and first.weights["pitch_down"] == 2.5 and "pitch_up" not in first.weights
+    # Lying as the cycle starts, but its last cycle stood at 50 deg on average: still levelling.
+    assert chooser(1, lying_state, MeanAttitude(math.radians(50.0), 0.0)).weights["pitch_down"] == 2.5
+    # The last cycle lay too (10 deg): done; the correction's weights from now on (at most 1 here).
+    after = chooser(2, lying_state, MeanAttitude(math.radians(10.0), 0.0))
+    assert after.weights.get("pitch_down", 0.0) <= 1.0 and chooser.held_rad["pitch"] != 0.0
+    # A swimmer lying at its start never levels off, whatever its last spell's mean.
+    assert chooser(0, lying_state, MeanAttitude(math.radians(50.0), 0.0)).weights.get("pitch_down", 0.0) <= 1.0
+
+
 def test_a_stroke_that_stood_up_or_rolled_over_mid_swim_swims_a_plain_cycle_at_its_level_off_tempo():
     """After a cycle whose mean pitch or shoulder roll went past the stroke's limits, the next
     cycle takes no sequence at all and runs at the level-off tempo; the held offsets wait; within

@@ -85,6 +85,8 @@ def test_shipped_strokes_load(name):
     (GOOD + "steering: {glide_moving_joints: [hip_l, tail]}\n", ["steering.glide_moving_joints", "tail"]),
     (GOOD + "steering: {max_weight: 1.3}\n", ["steering.max_weight", "multiple of 0.25"]),
     (GOOD + "steering: {yaw_fraction: 1.5}\n", ["steering.yaw_fraction"]),
+    (GOOD + "steering: {level_off_pitch_down_weight: 2}\n", ["steering.level_off_pitch_down_weight", "pitch_down"]),
+    (GOOD + "steering: {level_off_pitch_down_weight: 4}\n", ["steering.level_off_pitch_down_weight"]),
     (GOOD + "trim: {joints: {elbow_l: {flexion: 10}}}\n", ["trim.joints", "elbow_l.flexion", "range"]),
     (GOOD + "trim: {joints: {tail: {flexion: 10}}}\n", ["trim.joints.tail", "unknown joint"]),
     (GOOD + "trim: {light_from: 0.9, light_full: 0.95}\n", ["trim", "light_full < light_from"]),

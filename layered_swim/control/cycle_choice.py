@@ -32,7 +32,7 @@ from layered_swim.control.steering import (
     held_offset,
     turn_error,
 )
-from layered_swim.control.stroke import LEVEL_OFF
+from layered_swim.control.stroke import LEVEL_OFF, PITCH_DOWN
 from layered_swim.control.targets import Target, target_speed_m_s
 from layered_swim.state import BodyState
 
@@ -288,12 +288,14 @@ class TargetChooser:
     def __init__(self, target: Target, table: CalibrationTable, posture: str,
                  gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead: Lead = Lead(),
                  level_off_beyond_rad: float | None = None, level_off_tempo: float = 1.0,
-                 level_off_sequence: bool = True, recover_beyond_rad: tuple[float | None, float | None] = (None, None),
+                 level_off_sequence: bool = True, level_off_pitch_down_weight: float | None = None,
+                 recover_beyond_rad: tuple[float | None, float | None] = (None, None),
                  water: Callable[[], Water] | None = None):
         """``level_off_beyond_rad``: starting (cycle 0) pitched nose up by more than this beyond
-        any climb toward the target, swim at ``level_off_tempo`` every cycle until it is not (None:
-        never), taking the stroke's ``level_off`` sequence instead of a pitch correction where it
-        has one (``level_off_sequence``).
+        any climb toward the target, swim at ``level_off_tempo`` every cycle until neither the
+        pitch as a cycle starts nor the last cycle's mean is (None: never), taking the stroke's
+        ``level_off`` sequence (``level_off_sequence``: where it has one), or its pitch-down
+        sequence at ``level_off_pitch_down_weight``, instead of a pitch correction.
         ``recover_beyond_rad``: (pitch, roll); after a cycle whose mean pitch was more than the first
         nose up, or whose mean shoulder roll was more than the second either way, swim a plain
         cycle at ``level_off_tempo`` (None: never).
@@ -304,6 +306,7 @@ class TargetChooser:
         self.gains, self.tempo_control = gains, tempo
         self.level_off_beyond_rad, self.level_off_tempo = level_off_beyond_rad, level_off_tempo
         self.level_off_sequence = level_off_sequence
+        self.level_off_pitch_down_weight = level_off_pitch_down_weight
         self.recover_beyond_rad = recover_beyond_rad
         self._levelling = False
         self._last_error_rad = 0.0      # the last cycle's heading error, as steered
@@ -339,8 +342,12 @@ class TargetChooser:
         # to a target far above (sunk in light water) does not count: there the pitch is the climb.
         # Only at a start: mid-swim, a push that pitches it up is for the pitch correction.
         climb_rad = max(0.0, glide_pitch(position, target, self.gains))
-        self._levelling = (cycle == 0 or self._levelling) and self.level_off_beyond_rad is not None and (
-            att.pitch_rad - climb_rad > self.level_off_beyond_rad)
+        # Levelling goes on while the last cycle's mean is still pitched up too: the pitch swings
+        # within a cycle, and the breaststroke stopped levelling on a dip to 35 deg and stood up again.
+        pitch_rad = att.pitch_rad if last_cycle is None else max(att.pitch_rad, last_cycle.pitch_rad)
+        self._levelling = self.level_off_beyond_rad is not None and (
+            (cycle == 0 and att.pitch_rad - climb_rad > self.level_off_beyond_rad)
+            or (cycle > 0 and self._levelling and pitch_rad - climb_rad > self.level_off_beyond_rad))
         # Ahead of the target along its path: wait for it at the slowest tempo (turning at full tempo
         # instead carried the breaststroke further out of the figure-eight), gliding where the stroke
         # glides to wait (gliding, the breaststroke's depth drifted 0.27 m off a diving target's);
@@ -380,6 +387,8 @@ class TargetChooser:
             weights = {name: min(1.0, w) for name, w in weights.items()}
         if self._levelling and self.level_off_sequence:
             weights[LEVEL_OFF] = 1.0
+        if self._levelling and self.level_off_pitch_down_weight is not None:
+            weights[PITCH_DOWN] = self.level_off_pitch_down_weight
         # Near the target, or turning hard, the rules stop seeking more thrust (Yang 4.4: more force
         # only where more is wanted); else they speed the swimmer past a slow target.
         return CycleChoice(weights, tempo, glide, self.tempo_control.glide_cycles if glide else 1.0,
@@ -412,7 +421,8 @@ class TargetChooser:
         fractions = {"pitch": self.gains.pitch_fraction, "roll": self.gains.roll_fraction}
         weights = {}
         for axis, error in errors.items():
-            if fractions[axis] > 0.0 and not (axis == "pitch" and self._levelling and self.level_off_sequence):
+            levels_pitch = self.level_off_sequence or self.level_off_pitch_down_weight is not None
+            if fractions[axis] > 0.0 and not (axis == "pitch" and self._levelling and levels_pitch):
                 low, high = self.table.attitude_range(axis, tempo)
                 within = self.gains.attitude_within_rad
                 self.held_rad[axis] = held_offset(self.held_rad[axis], error, fractions[axis], low, high, within)

@@ -57,6 +57,7 @@ class StartSpec(Strict):
 
 # The steering sequences, each calibrated (turn per cycle against weight and tempo).
 SEQUENCE_NAMES = ("pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right")
+PITCH_DOWN = "pitch_down"     # also levels off a stroke set off standing up (``steering.level_off_pitch_down_weight``)
 # Lying down from upright (a lying stroke started from treading water): not calibrated, taken at
 # weight 1 in place of the pitch correction by a stroke that starts pitched up by more than
 # ``steering.level_off_beyond_deg`` beyond any climb toward the target, until it lies.
@@ -151,6 +152,9 @@ class SteeringSpec(Strict):
     # ``level_off`` sequence, where it has one, instead of correcting pitch.
     level_off_beyond_deg: float = Field(35.0, gt=0.0, le=90.0)
     level_off_tempo: float = Field(1.0, ge=0.1, le=1.5)    # the tempo of those level-off cycles
+    # ... and its pitch_down sequence at this weight in them, instead of the pitch correction (none:
+    # the correction, which holds pitch_down to the weights it was calibrated at, lying)
+    level_off_pitch_down_weight: float | None = Field(None, gt=0.0, le=3.0)
     # Mid-swim, after a cycle whose mean pitch was more than this nose up, or whose mean shoulder
     # roll was more than recover_beyond_roll_deg either way, a plain cycle (no sequence) at
     # level_off_tempo (none: never).
@@ -418,6 +422,9 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
     for joint in spec.pd_gain_scale:
         if joint not in joints:
             raise ConfigError(f"{source}: field 'pd_gain_scale.{joint}': unknown joint")
+    if spec.steering.level_off_pitch_down_weight is not None and PITCH_DOWN not in spec.perturbations:
+        raise ConfigError(f"{source}: field 'steering.level_off_pitch_down_weight': the stroke has no "
+                          f"{PITCH_DOWN} sequence")
     for joint in spec.steering.glide_moving_joints:
         if joint not in joints:
             raise ConfigError(f"{source}: field 'steering.glide_moving_joints': unknown joint '{joint}'")
