@@ -344,10 +344,9 @@ class TargetChooser:
         climb_rad = max(0.0, glide_pitch(position, target, self.gains))
         # Levelling goes on while the last cycle's mean is still pitched up too: the pitch swings
         # within a cycle, and the breaststroke stopped levelling on a dip to 35 deg and stood up again.
-        pitch_rad = att.pitch_rad if last_cycle is None else max(att.pitch_rad, last_cycle.pitch_rad)
-        self._levelling = self.level_off_beyond_rad is not None and (
-            (cycle == 0 and att.pitch_rad - climb_rad > self.level_off_beyond_rad)
-            or (cycle > 0 and self._levelling and pitch_rad - climb_rad > self.level_off_beyond_rad))
+        pitch_rad = att.pitch_rad if cycle == 0 or last_cycle is None else max(att.pitch_rad, last_cycle.pitch_rad)
+        self._levelling = (cycle == 0 or self._levelling) and self.level_off_beyond_rad is not None and (
+            pitch_rad - climb_rad > self.level_off_beyond_rad)
         # Ahead of the target along its path: wait for it at the slowest tempo (turning at full tempo
         # instead carried the breaststroke further out of the figure-eight), gliding where the stroke
         # glides to wait (gliding, the breaststroke's depth drifted 0.27 m off a diving target's);
@@ -420,8 +419,8 @@ class TargetChooser:
         errors = attitude_errors(mean, position_m, target_m, self.posture, level, self.gains)
         fractions = {"pitch": self.gains.pitch_fraction, "roll": self.gains.roll_fraction}
         weights = {}
+        levels_pitch = self.level_off_sequence or self.level_off_pitch_down_weight is not None
         for axis, error in errors.items():
-            levels_pitch = self.level_off_sequence or self.level_off_pitch_down_weight is not None
             if fractions[axis] > 0.0 and not (axis == "pitch" and self._levelling and levels_pitch):
                 low, high = self.table.attitude_range(axis, tempo)
                 within = self.gains.attitude_within_rad
