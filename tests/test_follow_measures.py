@@ -29,6 +29,17 @@ def test_depth_is_checked_only_while_the_target_holds_one():
     expected = np.where(t[holding] >= 25, 0.1, 0.5)
     assert got["hold_depth_error_m"] == pytest.approx(expected.mean())
     assert got["hold_depth_error_max_m"] == pytest.approx(0.5)
+    first, second = got["holds"]                  # one per stretch the target holds its depth
+    assert (first["target_z_m"], first["from_s"], first["to_s"]) == (-0.3, 0.0, 9.0)
+    assert first["mean_error_m"] == first["max_error_m"] == pytest.approx(0.5)
+    assert first["mean_above_m"] == pytest.approx(0.5)                 # short of it, not past it
+    assert (second["target_z_m"], second["from_s"], second["to_s"]) == (-2.3, 21.0, 29.0)
+    assert second["mean_error_m"] == pytest.approx((4 * 0.5 + 5 * 0.1) / 9)
+    assert (second["max_error_m"], second["max_error_at_s"]) == (pytest.approx(0.5), 21.0)
+    pelvis[25:, 2] = target[25:, 2] - 0.6         # now past it, deeper, at the end
+    second = hold_depth(t, pelvis, target)["holds"][1]
+    assert (second["max_error_m"], second["max_error_at_s"]) == (pytest.approx(0.6), 25.0)
+    assert second["mean_above_m"] == pytest.approx((4 * 0.5 - 5 * 0.6) / 9)
     assert hold_depth(t, pelvis, np.zeros((30, 3)) - 0.3) == {}      # one depth: nothing to hold
 
 

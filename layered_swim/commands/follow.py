@@ -63,9 +63,13 @@ def run(args) -> None:
     if args.json:
         print(json.dumps({**result, "out_dir": str(out.path)}, allow_nan=False))
         return
-    rows = {k: v for k, v in result.items() if not isinstance(v, dict)}
+    rows = {k: v for k, v in result.items() if not isinstance(v, dict) and k != "holds"}
     rows["strokes_swum"] = ", ".join(f"{spell['stroke']} {spell['from_s']:.1f}-{spell['to_s']:.1f} s"
                                      for spell in result["strokes_swum"])
+    for n, hold in enumerate(result.get("holds", []), 1):
+        rows[f"hold {n}"] = (f"z {hold['target_z_m']:.2f} m, {hold['from_s']:.1f}-{hold['to_s']:.1f} s: mean error "
+                             f"{hold['mean_error_m']:.2f} m, worst {hold['max_error_m']:.2f} m at "
+                             f"{hold['max_error_at_s']:.1f} s, pelvis {hold['mean_above_m']:+.2f} m above on average")
     rows.update({f"swim.{k}": v for k, v in result.get("swim_metrics", {}).items() if v is not None})
     print(table([[k, fmt(v)] for k, v in rows.items()]))
     print(f"\nwrote summary.json, config.json, track.npz, log.npz, timeseries.csv to {out.path}")

@@ -96,14 +96,27 @@ def stroke_spells(time_s: np.ndarray, strokes: np.ndarray) -> list[dict]:
 
 def hold_depth(time_s: np.ndarray, pelvis_m: np.ndarray, target_m: np.ndarray) -> dict:
     """For a target whose depth changes: the mean and worst distance between the pelvis's depth and
-    the target's while the target holds a depth; nothing for a target at one depth."""
+    the target's while the target holds a depth, and per hold (``holds``: one per unbroken stretch
+    of it) its ``target_z_m``, ``from_s``, ``to_s``, ``mean_error_m``, ``max_error_m`` and when that
+    was (``max_error_at_s``), and ``mean_above_m``, how far the pelvis stayed above the target's
+    depth on average (< 0: below), which tells a swimmer held short from one that overshot;
+    nothing for a target at one depth."""
     if len(time_s) < 2 or np.ptp(target_m[:, 2]) <= DEPTH_CHANGE_M:
         return {}
     holding = np.abs(np.gradient(target_m[:, 2], time_s)) < HOLDING_M_S
-    error = np.abs(pelvis_m[holding, 2] - target_m[holding, 2])
-    if not len(error):
+    if not holding.any():
         return {}
-    return {"hold_depth_error_m": float(error.mean()), "hold_depth_error_max_m": float(error.max())}
+    above = pelvis_m[:, 2] - target_m[:, 2]
+    error = np.abs(above[holding])
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], holding.astype(int), [0]])))
+    holds = []
+    for first, end in zip(edges[::2], edges[1::2]):
+        worst = first + int(np.argmax(np.abs(above[first:end])))
+        holds.append({"target_z_m": float(target_m[first, 2]), "from_s": float(time_s[first]),
+                      "to_s": float(time_s[end - 1]), "mean_error_m": float(np.abs(above[first:end]).mean()),
+                      "max_error_m": float(abs(above[worst])), "max_error_at_s": float(time_s[worst]),
+                      "mean_above_m": float(above[first:end].mean())})
+    return {"hold_depth_error_m": float(error.mean()), "hold_depth_error_max_m": float(error.max()), "holds": holds}
 
 
 def station_metrics(time_s: np.ndarray, distance_m: np.ndarray, jumps_s: list[float]) -> dict:
