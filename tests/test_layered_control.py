@@ -597,6 +597,29 @@ def test_a_swimmer_ahead_of_its_target_waits_for_it():
     assert not chasing.glide and chasing.cycles == 1.0 and chasing.thrust_demand == pytest.approx(1.0)
 
 
+def test_a_swimmer_waiting_for_its_target_turns_at_the_wait_turn_tempo():
+    """Waiting, a stroke with wait_turn_tempo swims at least that while the point it steers for is
+    more than 30 deg off its heading (the backstroke stood up turning at its slowest tempo), and at
+    its slowest tempo otherwise; without one, at its slowest tempo either way."""
+    waiting = TempoControl(min_tempo=0.55, wait_turn_tempo=0.8)
+    assert waiting.waiting_tempo(0.55, math.radians(40.0)) == pytest.approx(0.8)
+    assert waiting.waiting_tempo(0.55, math.radians(-90.0)) == pytest.approx(0.8)
+    assert waiting.waiting_tempo(0.55, math.radians(20.0)) == pytest.approx(0.55)
+    assert waiting.waiting_tempo(1.0, math.radians(90.0)) == pytest.approx(1.0)
+    assert TempoControl().waiting_tempo(0.5, math.radians(90.0)) == pytest.approx(0.5)
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
+    # A path along +y through the origin, the target 2 m (4 s) behind: the swimmer waits, turning left.
+    across = TrajectoryTarget(np.array([[0.0, -2.0, 0.0], [0.0, 20.0, 0.0]]), np.array([0.0, 22.0]), 0.5, False)
+    turning = TargetChooser(across, table(), "prone", tempo=waiting)(0, state, None)
+    assert turning.thrust_demand == 0.0 and turning.tempo == pytest.approx(0.8)
+    assert turning.weights.get("yaw_left", 0.0) > 0.0
+    along = TrajectoryTarget(np.array([[-2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 22.0]), 0.5, False)
+    straight = TargetChooser(along, table(), "prone", tempo=waiting)(0, state, None)
+    assert straight.thrust_demand == 0.0 and straight.tempo == pytest.approx(0.55)
+    plain = TargetChooser(across, table(), "prone", tempo=TempoControl(min_tempo=0.55))(0, state, None)
+    assert plain.tempo == pytest.approx(0.55)
+
+
 def test_a_swimmer_ahead_of_its_target_but_far_off_its_path_swims_back_instead_of_waiting():
     """Ahead of the target along its path waits only near the path: 2 m off it (a current carried
     the swimmer across a corner) it swims at full tempo back toward the path."""
@@ -806,9 +829,9 @@ def test_a_stroke_that_stood_up_or_rolled_over_mid_swim_swims_a_plain_cycle_at_i
 
 
 def test_the_backstroke_waiting_for_a_slow_target_rights_itself_instead_of_stalling():
-    """Its slowest tempo swims 0.9 m/s: ahead of the straight line's 0.5 m/s target it turns back
-    at that tempo and stands up; without the recovery it stalled there with every sequence at full
-    weight and fell ever further behind (18-22 m after 90 s, seeds 1-3; with it 3-8 m)."""
+    """Its slowest tempo swims faster than the straight line's 0.5 m/s target: ahead of it, it turns
+    back to wait, and turning slowly it stands up; without the recovery it stalled there with every
+    sequence at full weight and fell ever further behind (18-22 m after 90 s, seeds 1-3; with it 3-8 m)."""
     spec = SwimSpec.of("t", stroke="backstroke", task={"kind": "follow", "trajectory": "straight_line"},
                        seconds=90.0, seed=1)
     track = swim(spec.episode(), 90.0).task.track()

@@ -62,6 +62,10 @@ class TempoControl:
     alone left the breaststroke trailing its target by 0.45 m on a straight line (steering costs it
     speed that the calibration's pace does not know of), and a current against it further.
 
+    ``wait_turn_tempo``: waiting for a moving target, at least this tempo while it is more than
+    ``easy_turn_rad`` off the heading (None: the slowest): the backstroke's slowest tempo (0.5)
+    swims its straights at 0.6 m/s, near a 0.5 m/s target's pace, but turning there it stands up.
+
     ``dive_tempo``: at least this tempo while the point steered for lies more than ``dive_below_m``
     below the centre of mass (a stroke that lies nose-up when slow cannot pitch down far enough to
     dive there: the breaststroke lies at 21 deg at tempo 0.7 and its pitch-down sequence takes it
@@ -81,6 +85,7 @@ class TempoControl:
     dive_tempo: float | None = None
     dive_below_m: float = 0.3
     close_gap_s: float | None = None
+    wait_turn_tempo: float | None = None
 
     def closing_speed_m_s(self, pace_m_s: float, behind_m: float) -> float:
         """The speed to swim at behind a target moving at ``pace_m_s`` by ``behind_m`` along its
@@ -102,6 +107,12 @@ class TempoControl:
         if (self.turn_tempo is not None and abs(heading_error_rad) > self.easy_turn_rad
                 and ahead_of_target_s <= self.turn_tempo_until_ahead_s):
             return max(tempo, self.turn_tempo)
+        return tempo
+
+    def waiting_tempo(self, tempo: float, heading_error_rad: float) -> float:
+        """``tempo`` while waiting, raised to ``wait_turn_tempo`` for a turn wider than ``easy_turn_rad``."""
+        if self.wait_turn_tempo is not None and abs(heading_error_rad) > self.easy_turn_rad:
+            return max(tempo, self.wait_turn_tempo)
         return tempo
 
     def catching_up_tempo(self, tempo: float, distance_m: float, ahead_of_target_s: float) -> float:
@@ -362,7 +373,9 @@ class TargetChooser:
                 closing = self.tempo_control.closing_speed_m_s(speed_m_s, behind_along_m(path, state.time_s, position))
                 fastest = self.tempo_control.turn_tempo or 1.0
                 tempo = max(tempo, min(fastest, self.table.pace.tempo_for_speed(closing)))
-        if not waiting:
+        if waiting:
+            tempo = self.tempo_control.waiting_tempo(tempo, heading_error)
+        else:
             tempo = self.tempo_control.turning_tempo(tempo, heading_error, ahead_of_target_s)
             if foresight:
                 tempo = self.tempo_control.catching_up_tempo(tempo, distance, ahead_of_target_s)

@@ -133,6 +133,9 @@ class SteeringSpec(Strict):
     # ... and only within this of the path (farther off, swim back to it; a stroke that follows
     # loosely waits from farther).
     wait_within_m: float = Field(1.0, gt=0.0, le=100.0)
+    # ... and, waiting, at least this tempo while turning more than 30 deg (none: the slowest): a
+    # stroke whose slowest tempo is too slow to turn on lying down stands up there (the backstroke).
+    wait_turn_tempo: float | None = Field(None, ge=0.1, le=1.5)
     # ... and only within this of the depth it steers for (none: at any depth): a stroke that rides
     # up at its slowest tempo (the breaststroke) dives on instead of waiting above a diving path.
     wait_depth_within_m: float | None = Field(None, gt=0.0, le=10.0)
