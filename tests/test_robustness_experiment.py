@@ -17,7 +17,7 @@ def test_it_is_an_experiment_with_every_stroke_path_and_condition():
                                                "density_1500"}
     assert len({c["start"] for c in full}) == rb.STARTS >= 10
     quick = rb.configs(True, 0)
-    assert len(quick) == 3 * 2 * 4 * 2 and all(c["seconds"] == 30.0 for c in quick)
+    assert len(quick) == 5 * 2 * 4 * 2 and all(c["seconds"] == 30.0 for c in quick)
 
 
 def test_a_current_comes_from_the_direction_named_and_a_density_is_the_waters():

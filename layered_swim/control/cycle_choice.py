@@ -63,8 +63,9 @@ class TempoControl:
     speed that the calibration's pace does not know of), and a current against it further.
 
     ``wait_turn_tempo``: waiting for a moving target, at least this tempo while it is more than
-    ``easy_turn_rad`` off the heading (None: the slowest): the backstroke's slowest tempo (0.5)
-    swims its straights at 0.6 m/s, near a 0.5 m/s target's pace, but turning there it stands up.
+    ``easy_turn_rad`` off the heading (None: the slowest): the backstroke's slowest tempo (0.55)
+    swims its straights at ~0.7 m/s, nearer a 0.5 m/s target's pace than 0.65 (0.9 m/s), but
+    turning that slowly it stands up.
 
     ``dive_tempo``: at least this tempo while the point steered for lies more than ``dive_below_m``
     below the centre of mass (a stroke that lies nose-up when slow cannot pitch down far enough to

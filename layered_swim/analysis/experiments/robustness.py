@@ -4,7 +4,7 @@ cell the median over moved starts. A cell holds when its median mean distance to
 at most ``HOLD_M``; after a push, the swimmer should be back within ``BACK_WITHIN_M`` of the path in
 at most ``BACK_WITHIN_S`` seconds.
 
-The full sweep is 3780 minute-long swims (~1 hour on two cores): it is cached run by run in
+The full sweep is 6300 minute-long swims (~2 hours on two cores): it is cached run by run in
 the output folder, so a stopped sweep goes on where it stopped, and ``--ray ADDRESS`` spreads it
 over a Ray cluster."""
 from __future__ import annotations
@@ -31,7 +31,7 @@ PAPER = ("Yang et al. 2004 show their swimmer following paths in still water and
          f"{BACK_WITHIN_S:g} s after a push (median).")
 FIGURE = "robustness.png"
 CSV = "robustness.csv"
-STROKES = ("breaststroke", "front_crawl", "auto")
+STROKES = ("breaststroke", "front_crawl", "backstroke", "butterfly", "auto")
 PATHS = ("figure_eight", "circle", "small_loops", "sinusoid", "straight_line", "zigzag", "square",
          "dive_and_surface", "deep_dive")
 CURRENT_M_S = 0.3
