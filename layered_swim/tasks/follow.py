@@ -107,16 +107,17 @@ def hold_depth(time_s: np.ndarray, pelvis_m: np.ndarray, target_m: np.ndarray) -
     if not holding.any():
         return {}
     above = pelvis_m[:, 2] - target_m[:, 2]
-    error = np.abs(above[holding])
+    error = np.abs(above)
     edges = np.flatnonzero(np.diff(np.concatenate([[0], holding.astype(int), [0]])))
     holds = []
     for first, end in zip(edges[::2], edges[1::2]):
-        worst = first + int(np.argmax(np.abs(above[first:end])))
+        worst = first + int(np.argmax(error[first:end]))
         holds.append({"target_z_m": float(target_m[first, 2]), "from_s": float(time_s[first]),
-                      "to_s": float(time_s[end - 1]), "mean_error_m": float(np.abs(above[first:end]).mean()),
-                      "max_error_m": float(abs(above[worst])), "max_error_at_s": float(time_s[worst]),
+                      "to_s": float(time_s[end - 1]), "mean_error_m": float(error[first:end].mean()),
+                      "max_error_m": float(error[worst]), "max_error_at_s": float(time_s[worst]),
                       "mean_above_m": float(above[first:end].mean())})
-    return {"hold_depth_error_m": float(error.mean()), "hold_depth_error_max_m": float(error.max()), "holds": holds}
+    return {"hold_depth_error_m": float(error[holding].mean()), "hold_depth_error_max_m": float(error[holding].max()),
+            "holds": holds}
 
 
 def station_metrics(time_s: np.ndarray, distance_m: np.ndarray, jumps_s: list[float]) -> dict:
