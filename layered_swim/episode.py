@@ -255,9 +255,13 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                     level_off_sequence=LEVEL_OFF in stroke.perturbations,
                                     level_off_pitch_down_weight=(None if goal_line
                                                                  else steer.level_off_pitch_down_weight),
-                                    recover_beyond_rad=recover, water=None if goal_line else water)
+                                    recover_beyond_rad=recover, water=None if goal_line else water,
+                                    under_water_below_m=None if goal_line else steer.under_water_below_m)
         else:
             weights = fixed_weights({}, tempo=tempo)
-    lungs = (LungControl(body.lung_air_l, body.max_lung_air_l, breathe_out=stroke.steering.breathe_out)
+    lungs = (LungControl(body.lung_air_l, body.max_lung_air_l, breathe_out=stroke.steering.breathe_out,
+                         damping_s=stroke.steering.breathe_damping_s,
+                         deep_below_m=stroke.steering.under_water_below_m or 0.0,
+                         deep_air_l=stroke.steering.under_water_air_l)
              if stroke.steering.breathe and not goal_line else None)
     return LayeredController(stroke, layout, arm_indices(body, layout), weights, layers, target, lungs)

@@ -33,6 +33,7 @@ from layered_swim.control.steering import (
 )
 from layered_swim.control.stroke import (
     LEVEL_OFF,
+    UNDER_WATER,
     JointKeys,
     PerturbationSpec,
     RulesSpec,
@@ -482,8 +483,9 @@ def test_shipped_calibration_is_fresh_and_every_steering_sequence_acts_monotonic
     stroke = load_stroke(stroke_name, LAYOUT)
     shipped = load_table(stroke)                       # raises if missing or stale
     assert set(shipped.turn_rad) == {"yaw_left", "yaw_right"}
-    assert set(shipped.attitude_rad) == set(stroke.perturbations) - {LEVEL_OFF, "yaw_left", "yaw_right"} == set(
-        ("pitch_up", "pitch_down", "roll_left", "roll_right"))     # level-off: uncalibrated
+    uncalibrated = {LEVEL_OFF, UNDER_WATER}
+    assert set(shipped.attitude_rad) == set(stroke.perturbations) - uncalibrated - {"yaw_left", "yaw_right"} == set(
+        ("pitch_up", "pitch_down", "roll_left", "roll_right"))
     assert shipped.weights[-1] == stroke.steering.max_weight
     for name, rows in shipped.turn_rad.items():
         assert np.all(np.diff(rows, axis=1) > 0), f"{stroke_name} {name}: {np.degrees(rows).round(2)}"
@@ -581,6 +583,11 @@ def test_lead_aims_from_the_swimmers_own_place_on_the_path_when_it_is_ahead():
     # is over where the target will be in 2 s, but nearest (in 3-D) to where it is in 0.4 s.
     dive = TrajectoryTarget(np.array([[0.0, 0.0, -0.3], [2.0, 0.0, -4.3]]), np.array([0.0, 8.0]), 1.0, False)
     assert lead.aim(dive, 0.0, np.array([0.5, 0.0, -0.3]))[1] == pytest.approx(0.4)
+    # It aims along the path from there, but at the depth the target reaches 1.5 s from now, not the
+    # path's depth there: x = 0.25 (0.4 + 1.5) = 0.475 m, z = -0.3 - 0.5 * 1.5 = -1.05 m.
+    assert lead.aim(dive, 0.0, np.array([0.5, 0.0, -0.3]))[0] == pytest.approx([0.475, 0.0, -1.05])
+    aim, ahead_s, _ = lead.aim(dive, 0.0, np.array([1.0, 0.0, -2.3]))     # 4 s ahead, at the path's depth there
+    assert ahead_s == pytest.approx(4.0) and aim == pytest.approx([0.25 * 5.5, 0.0, -1.05])
 
 
 def test_a_swimmer_ahead_of_its_target_waits_for_it():
@@ -778,6 +785,23 @@ def test_a_swimmer_starting_pitched_up_levels_off_instead_of_correcting_pitch():
     first = plain(0, standing, None)
     assert first.tempo == 1.2 and LEVEL_OFF not in first.weights and "pitch_down" in first.weights
     assert plain(1, lying_state, None).tempo == pytest.approx(TempoControl().min_tempo)
+
+
+def test_a_stroke_aiming_under_water_takes_its_under_water_sequence_at_full_weight():
+    """Below ``under_water_below_m`` (the point steered for, from the surface) the under-water
+    sequence joins every cycle's weights at 1, glides and plain recovery cycles too; above, never."""
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
+    for depth_m, under in ((0.3, False), (0.5, False), (2.0, True)):
+        target = FixedTarget((5.0, 0.0, -depth_m))
+        chooser = TargetChooser(target, table(), "prone", under_water_below_m=0.6,
+                                tempo=TempoControl(glide_within_m=10.0))
+        choice = chooser(0, state, None)
+        assert (choice.weights.get(UNDER_WATER) == 1.0) is under and choice.glide
+        recovering = TargetChooser(target, table(), "prone", under_water_below_m=0.6,
+                                   recover_beyond_rad=(math.radians(25.0), None))
+        stood = MeanAttitude(math.radians(40.0), 0.0)
+        assert recovering(1, state, stood).weights == ({UNDER_WATER: 1.0} if under else {})
+    assert UNDER_WATER not in TargetChooser(FixedTarget((5.0, 0.0, -2.0)), table(), "prone")(0, state, None).weights
 
 
 def test_a_stroke_levels_off_with_its_pitch_down_sequence_overweighted_until_its_cycles_lie():

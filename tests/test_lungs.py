@@ -23,6 +23,25 @@ def test_the_lungs_breathe_out_to_sink_and_in_to_rise_no_faster_than_a_breath():
     assert LUNGS.next_air_l(3.0, 0.4, 0.4, 0.5) == pytest.approx(3.0)        # at depth: the resting breath
 
 
+def test_damped_lungs_take_the_depth_error_ahead_at_the_rate_it_closes():
+    damped = LungControl(rest_air_l=3.0, max_air_l=5.5, gain_l_per_m=6.0, rate_l_per_s=3.0, damping_s=4.0)
+    # 0.25 m short of the target, nearing it at 0.05 m/s: 0.25 - 4 * 0.05 = 0.05 m, so 3 - 0.3 = 2.7 L
+    assert damped.next_air_l(2.8, 0.5, 0.75, 1.0, closing_m_s=0.05) == pytest.approx(2.7)
+    # ... leaving it at 0.05 m/s: 0.45 m, so 3 - 2.7 = 0.3 L
+    assert damped.next_air_l(0.5, 0.5, 0.75, 1.0, closing_m_s=-0.05) == pytest.approx(0.3)
+    # at the target's depth but still sinking past it at 0.1 m/s: breathes in to 3 + 6 * 0.4 = 5.4 L
+    assert damped.next_air_l(5.0, 2.0, 2.0, 1.0, closing_m_s=0.1) == pytest.approx(5.4)
+    assert LUNGS.next_air_l(2.8, 0.5, 0.75, 1.0, closing_m_s=0.05) == pytest.approx(1.5)   # undamped: the error alone
+    deep_only = LungControl(rest_air_l=3.0, max_air_l=5.5, damping_s=4.0, deep_below_m=0.6)
+    assert deep_only.next_air_l(2.8, 0.5, 0.75, 1.0, closing_m_s=0.05) == pytest.approx(2.7)    # 0.75 m: damped
+    assert deep_only.next_air_l(2.8, 0.3, 0.5, 1.0, closing_m_s=0.05) == pytest.approx(1.8)     # 0.5 m: 3 - 6 * 0.2
+    # ... holding 1.5 L at a deep target's depth: 1.5 - 6 * 0.05 = 1.2 L; near the surface the resting breath
+    deep_air = LungControl(rest_air_l=3.0, max_air_l=5.5, damping_s=4.0, deep_below_m=0.6, deep_air_l=1.5)
+    assert deep_air.next_air_l(1.3, 0.5, 0.75, 1.0, closing_m_s=0.05) == pytest.approx(1.2)
+    assert deep_air.next_air_l(2.8, 0.3, 0.5, 1.0, closing_m_s=0.05) == pytest.approx(1.8)
+    assert deep_air.next_air_l(1.0, 3.0, 3.0, 1.0) == pytest.approx(1.5)
+
+
 def test_a_stroke_that_only_breathes_in_rises_but_never_empties_to_sink():
     rising_only = LungControl(rest_air_l=3.0, max_air_l=5.5, breathe_out=False)
     assert rising_only.next_air_l(3.0, 0.5, 0.75, 0.1) == pytest.approx(3.0)   # deeper target: stays at rest

@@ -87,6 +87,7 @@ def test_shipped_strokes_load(name):
     (GOOD + "steering: {yaw_fraction: 1.5}\n", ["steering.yaw_fraction"]),
     (GOOD + "steering: {level_off_pitch_down_weight: 2}\n", ["steering.level_off_pitch_down_weight", "pitch_down"]),
     (GOOD + "steering: {level_off_pitch_down_weight: 4}\n", ["steering.level_off_pitch_down_weight"]),
+    (GOOD + "steering: {under_water_below_m: 0.6}\n", ["steering.under_water_below_m", "under_water"]),
     (GOOD + "trim: {joints: {elbow_l: {flexion: 10}}}\n", ["trim.joints", "elbow_l.flexion", "range"]),
     (GOOD + "trim: {joints: {tail: {flexion: 10}}}\n", ["trim.joints.tail", "unknown joint"]),
     (GOOD + "trim: {light_from: 0.9, light_full: 0.95}\n", ["trim", "light_full < light_from"]),

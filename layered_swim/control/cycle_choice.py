@@ -32,7 +32,7 @@ from layered_swim.control.steering import (
     held_offset,
     turn_error,
 )
-from layered_swim.control.stroke import LEVEL_OFF, PITCH_DOWN
+from layered_swim.control.stroke import LEVEL_OFF, PITCH_DOWN, UNDER_WATER
 from layered_swim.control.targets import Target, target_speed_m_s
 from layered_swim.state import BodyState
 
@@ -228,7 +228,11 @@ class Lead:
         path, not back at the target: swimming back to a target that comes toward it only circles it."""
         place_s, off_path_m = self.place_on_path_s(target, time_s, position_m)
         from_s = max(time_s, place_s)
-        return target.position(from_s + self.seconds(target, from_s)), place_s - time_s, off_path_m
+        aim_m = np.array(target.position(from_s + self.seconds(target, from_s)), dtype=float)
+        # ... but at the depth the target itself reaches straight_s from now: a swimmer ahead along a
+        # diving path held the path's depth there and left a hold early, and one behind dived late.
+        aim_m[2] = target.position(time_s + self.straight_s)[2]
+        return aim_m, place_s - time_s, off_path_m
 
     def waits(self, ahead_of_target_s: float, off_path_m: float, depth_off_m: float = 0.0) -> bool:
         """Whether to wait for the target: well ahead of it along its path, and on the path, at
@@ -302,7 +306,7 @@ class TargetChooser:
                  level_off_beyond_rad: float | None = None, level_off_tempo: float = 1.0,
                  level_off_sequence: bool = True, level_off_pitch_down_weight: float | None = None,
                  recover_beyond_rad: tuple[float | None, float | None] = (None, None),
-                 water: Callable[[], Water] | None = None):
+                 water: Callable[[], Water] | None = None, under_water_below_m: float | None = None):
         """``level_off_beyond_rad``: starting (cycle 0) pitched nose up by more than this beyond
         any climb toward the target, swim at ``level_off_tempo`` every cycle until neither the
         pitch as a cycle starts nor the last cycle's mean is (None: never), taking the stroke's
@@ -312,7 +316,9 @@ class TargetChooser:
         nose up, or whose mean shoulder roll was more than the second either way, swim a plain
         cycle at ``level_off_tempo`` (None: never).
         ``water()``: the water swum in now; a target on a known path is then steered for in the
-        frame of the water's steady current where the swimmer is (``InWater``)."""
+        frame of the water's steady current where the swimmer is (``InWater``).
+        ``under_water_below_m``: the stroke's ``under_water`` sequence at weight 1, on top of the
+        rest, while the point steered for lies deeper than this below the surface (None: never)."""
         self.target, self.table, self.posture, self.lead = target, table, posture, lead
         self.water = water
         self.gains, self.tempo_control = gains, tempo
@@ -320,6 +326,7 @@ class TargetChooser:
         self.level_off_sequence = level_off_sequence
         self.level_off_pitch_down_weight = level_off_pitch_down_weight
         self.recover_beyond_rad = recover_beyond_rad
+        self.under_water_below_m = under_water_below_m
         self._levelling = False
         self._last_error_rad = 0.0      # the last cycle's heading error, as steered
         self.held_rad = {"pitch": 0.0, "roll": 0.0}     # the attitude offsets the sequences hold
@@ -392,7 +399,7 @@ class TargetChooser:
             # Turning slowly, the backstroke stood up or rolled onto its side and stalled there for
             # tens of seconds with every sequence at full weight; a plain cycle at speed rights it
             # (the held offsets wait, as through a glide).
-            return CycleChoice({}, self.level_off_tempo, thrust_demand=drive)
+            return CycleChoice(self._under_water(target), self.level_off_tempo, thrust_demand=drive)
         weights = {}        # a glide holds its first pose: no sequence, and the held offsets wait
         if not glide:
             weights = self.table.weights_for(yaw, tempo) | self._attitude_weights(mean, position, target, tempo)
@@ -402,6 +409,7 @@ class TargetChooser:
             weights[LEVEL_OFF] = 1.0
         if self._levelling and self.level_off_pitch_down_weight is not None:
             weights[PITCH_DOWN] = self.level_off_pitch_down_weight
+        weights |= self._under_water(target)
         # Near the target, or turning hard, the rules stop seeking more thrust (Yang 4.4: more force
         # only where more is wanted); else they speed the swimmer past a slow target.
         return CycleChoice(weights, tempo, glide, self.tempo_control.glide_cycles if glide else 1.0,
@@ -413,6 +421,12 @@ class TargetChooser:
         return last_cycle is not None and (
             (pitch_rad is not None and last_cycle.pitch_rad > pitch_rad)
             or (roll_rad is not None and abs(last_cycle.roll_rad) > roll_rad))
+
+    def _under_water(self, aim_m: np.ndarray) -> dict[str, float]:
+        """The under-water sequence's weight, by the depth of the point steered for (glides too)."""
+        if self.under_water_below_m is None or self._surface_z_m() - float(aim_m[2]) <= self.under_water_below_m:
+            return {}
+        return {UNDER_WATER: 1.0}
 
     def _surface_z_m(self) -> float:
         return self.water().surface_z_m if self.water is not None else 0.0

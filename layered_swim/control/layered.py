@@ -25,6 +25,7 @@ from layered_swim.geometry import ease, unit_vector
 from layered_swim.state import BodyState, JointLayout
 
 BLEND_CYCLES = 0.15   # a new cycle's weights take over within this fraction of it
+BREATH_RATE_STEP_S = 0.5   # the target's sinking rate, for the lungs, from its move over this long
 
 
 @dataclass(frozen=True)
@@ -186,8 +187,10 @@ class LayeredController:
     def _breathe(self, time_s: float, state: BodyState) -> None:
         dt_s = time_s - self._last_breath_s if self._last_breath_s is not None else 0.0
         self._last_breath_s = time_s
-        self.lung_air_l = self.lungs.next_air_l(self.lung_air_l, -float(state.pos("pelvis")[2]),
-                                                -float(self.target.position(time_s)[2]), dt_s)
+        target_z_m = float(self.target.position(time_s)[2])
+        target_vz_m_s = (float(self.target.position(time_s + BREATH_RATE_STEP_S)[2]) - target_z_m) / BREATH_RATE_STEP_S
+        self.lung_air_l = self.lungs.next_air_l(self.lung_air_l, -float(state.pos("pelvis")[2]), -target_z_m, dt_s,
+                                                target_vz_m_s - float(state.com_vel_m_s[2]))
 
     def _track_attitude(self, state: BodyState, forward: np.ndarray) -> None:
         """Accumulate the cycle's mean pitch and shoulder roll: a crawl rolls +-30 deg within a

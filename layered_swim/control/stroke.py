@@ -62,7 +62,10 @@ PITCH_DOWN = "pitch_down"     # also levels off a stroke set off standing up (``
 # weight 1 in place of the pitch correction by a stroke that starts pitched up by more than
 # ``steering.level_off_beyond_deg`` beyond any climb toward the target, until it lies.
 LEVEL_OFF = "level_off"
-ALL_SEQUENCES = SEQUENCE_NAMES + (LEVEL_OFF,)
+# Under water (the point steered for deeper than ``steering.under_water_below_m``): not calibrated,
+# taken at weight 1 on top of the rest; a stroke that lifts its head to breathe leaves that out.
+UNDER_WATER = "under_water"
+ALL_SEQUENCES = SEQUENCE_NAMES + (LEVEL_OFF, UNDER_WATER)
 Sequence = Literal[ALL_SEQUENCES]
 
 
@@ -167,6 +170,15 @@ class SteeringSpec(Strict):
     # ... breathing out below the resting breath too (false: only in, to rise back from a push;
     # a crawl that emptied its lungs to dive sank legs first, nose up)
     breathe_out: bool = True
+    # ... taking the depth error this many seconds ahead at the rate it closes (0: the error alone),
+    # while the target lies deeper than under_water_below_m (where set)
+    breathe_damping_s: float = Field(0.0, ge=0.0, le=20.0)
+    # ... and there holds this much air at the target's depth (none: the resting breath)
+    under_water_air_l: float | None = Field(None, ge=0.0, le=8.0)
+    # Its ``under_water`` sequence at weight 1 while the point it steers for lies deeper than this
+    # (none: never): under water a swimmer does not lift its head to breathe, and that lift rose the
+    # breaststroke from 3 m with empty lungs.
+    under_water_below_m: float | None = Field(None, gt=0.0, le=20.0)
 
 
 class TrimSpec(Strict):
@@ -425,6 +437,8 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
     for joint in spec.pd_gain_scale:
         if joint not in joints:
             raise ConfigError(f"{source}: field 'pd_gain_scale.{joint}': unknown joint")
+    if spec.steering.under_water_below_m is not None and UNDER_WATER not in spec.perturbations:
+        raise ConfigError(f"{source}: field 'steering.under_water_below_m': the stroke has no {UNDER_WATER} sequence")
     if spec.steering.level_off_pitch_down_weight is not None and PITCH_DOWN not in spec.perturbations:
         raise ConfigError(f"{source}: field 'steering.level_off_pitch_down_weight': the stroke has no "
                           f"{PITCH_DOWN} sequence")
@@ -441,8 +455,9 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
         raise ConfigError(f"{source}: field 'trim.joints': {layout.names[k]} with its trim leaves the range of motion")
     # What calibration measures: it swims without the rules, and the steering settings only read
     # its table, so both stay out; so does the trim, nothing in the water calibration swims in,
-    # and the level-off, which steering takes only at a start standing up.
-    exclude = {"steering": True, "rules": True, "trim": True, "perturbations": {LEVEL_OFF}}
+    # and the level-off and under-water sequences, which steering takes only at a start standing up
+    # or below the surface.
+    exclude = {"steering": True, "rules": True, "trim": True, "perturbations": {LEVEL_OFF, UNDER_WATER}}
     digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude=exclude),
                                        sort_keys=True).encode()).hexdigest()
     return Stroke(spec.name, spec.description, spec.period_s, spec.start, basic, perturbations, spec.rules,
