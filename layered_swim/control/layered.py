@@ -20,7 +20,7 @@ from layered_swim.control.lungs import LungControl
 from layered_swim.control.rules import Arms, rule_offsets
 from layered_swim.control.steering import MeanAttitude, elevation, forward_axis, shoulder_roll
 from layered_swim.control.stroke import ALL_SEQUENCES, Stroke
-from layered_swim.control.targets import Target
+from layered_swim.control.targets import Target, target_velocity_m_s
 from layered_swim.geometry import ease, unit_vector
 from layered_swim.state import BodyState, JointLayout
 
@@ -187,9 +187,9 @@ class LayeredController:
     def _breathe(self, time_s: float, state: BodyState) -> None:
         dt_s = time_s - self._last_breath_s if self._last_breath_s is not None else 0.0
         self._last_breath_s = time_s
-        target_z_m = float(self.target.position(time_s)[2])
-        target_vz_m_s = (float(self.target.position(time_s + BREATH_RATE_STEP_S)[2]) - target_z_m) / BREATH_RATE_STEP_S
-        self.lung_air_l = self.lungs.next_air_l(self.lung_air_l, -float(state.pos("pelvis")[2]), -target_z_m, dt_s,
+        target_vz_m_s = float(target_velocity_m_s(self.target, time_s, BREATH_RATE_STEP_S)[2])
+        self.lung_air_l = self.lungs.next_air_l(self.lung_air_l, -float(state.pos("pelvis")[2]),
+                                                -float(self.target.position(time_s)[2]), dt_s,
                                                 target_vz_m_s - float(state.com_vel_m_s[2]))
 
     def _track_attitude(self, state: BodyState, forward: np.ndarray) -> None:
