@@ -627,6 +627,23 @@ def test_a_swimmer_waiting_for_its_target_turns_at_the_wait_turn_tempo():
     assert plain.tempo == pytest.approx(0.55)
 
 
+def test_a_swimmer_waiting_with_a_wait_pace_keeps_that_share_of_its_targets_pace():
+    """Waiting, a stroke with wait_pace swims at least the tempo whose steady speed (its pace table)
+    is that share of the target's pace, not its slowest (where the breaststroke stalls nose-up)."""
+    pacing = TempoControl(min_tempo=0.5, wait_pace=1.0)
+    assert pacing.waiting_tempo(0.5, 0.0, pace_tempo=0.75) == pytest.approx(0.75)
+    assert pacing.waiting_tempo(0.9, 0.0, pace_tempo=0.75) == pytest.approx(0.9)
+    assert TempoControl(min_tempo=0.5).waiting_tempo(0.5, 0.0, pace_tempo=0.75) == pytest.approx(0.5)
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
+    # The target 2 m (4 s) behind on a path along +x at 0.5 m/s: the swimmer waits at the tempo of
+    # 0.5 m/s, which the table's pace (0.4 m/s at 0.5, 0.8 m/s at 1.0) puts at 0.625.
+    along = TrajectoryTarget(np.array([[-2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 22.0]), 0.5, False)
+    waiting = TargetChooser(along, table(), "prone", tempo=pacing)(0, state, None)
+    assert waiting.thrust_demand == 0.0 and waiting.tempo == pytest.approx(0.625)
+    slowest = TargetChooser(along, table(), "prone", tempo=TempoControl(min_tempo=0.5))(0, state, None)
+    assert slowest.thrust_demand == 0.0 and slowest.tempo == pytest.approx(0.5)
+
+
 def test_a_swimmer_ahead_of_its_target_but_far_off_its_path_swims_back_instead_of_waiting():
     """Ahead of the target along its path waits only near the path: 2 m off it (a current carried
     the swimmer across a corner) it swims at full tempo back toward the path."""

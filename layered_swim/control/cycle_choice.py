@@ -67,6 +67,10 @@ class TempoControl:
     swims its straights at ~0.7 m/s, nearer a 0.5 m/s target's pace than 0.65 (0.9 m/s), but
     turning that slowly it stands up.
 
+    ``wait_pace``: waiting for a moving target, at least the tempo whose steady speed is this share
+    of the target's pace (None: the slowest): at its slowest the breaststroke stalls nose-up, and
+    once the target passes it must start again from standing.
+
     ``dive_tempo``: at least this tempo while the point steered for lies more than ``dive_below_m``
     below the centre of mass (a stroke that lies nose-up when slow cannot pitch down far enough to
     dive there: the breaststroke lies at 21 deg at tempo 0.7 and its pitch-down sequence takes it
@@ -87,6 +91,7 @@ class TempoControl:
     dive_below_m: float = 0.3
     close_gap_s: float | None = None
     wait_turn_tempo: float | None = None
+    wait_pace: float | None = None
 
     def closing_speed_m_s(self, pace_m_s: float, behind_m: float) -> float:
         """The speed to swim at behind a target moving at ``pace_m_s`` by ``behind_m`` along its
@@ -110,10 +115,14 @@ class TempoControl:
             return max(tempo, self.turn_tempo)
         return tempo
 
-    def waiting_tempo(self, tempo: float, heading_error_rad: float) -> float:
-        """``tempo`` while waiting, raised to ``wait_turn_tempo`` for a turn wider than ``easy_turn_rad``."""
+    def waiting_tempo(self, tempo: float, heading_error_rad: float, pace_tempo: float | None = None) -> float:
+        """``tempo`` while waiting, raised to ``wait_turn_tempo`` for a turn wider than ``easy_turn_rad``
+        and, with ``wait_pace``, to ``pace_tempo``: the tempo whose steady speed is that share of the
+        target's pace."""
         if self.wait_turn_tempo is not None and abs(heading_error_rad) > self.easy_turn_rad:
-            return max(tempo, self.wait_turn_tempo)
+            tempo = max(tempo, self.wait_turn_tempo)
+        if self.wait_pace is not None and pace_tempo is not None:
+            tempo = max(tempo, pace_tempo)
         return tempo
 
     def catching_up_tempo(self, tempo: float, distance_m: float, ahead_of_target_s: float) -> float:
@@ -382,7 +391,11 @@ class TargetChooser:
                 fastest = self.tempo_control.turn_tempo or 1.0
                 tempo = max(tempo, min(fastest, self.table.pace.tempo_for_speed(closing)))
         if waiting:
-            tempo = self.tempo_control.waiting_tempo(tempo, heading_error)
+            pace_tempo = None
+            if self.tempo_control.wait_pace is not None:
+                speed_m_s = target_speed_m_s(path, state.time_s + ahead_of_target_s, STEP_S)
+                pace_tempo = min(1.0, self.table.pace.tempo_for_speed(self.tempo_control.wait_pace * speed_m_s))
+            tempo = self.tempo_control.waiting_tempo(tempo, heading_error, pace_tempo)
         else:
             tempo = self.tempo_control.turning_tempo(tempo, heading_error, ahead_of_target_s)
             if foresight:

@@ -139,6 +139,9 @@ class SteeringSpec(Strict):
     # ... and, waiting, at least this tempo while turning more than 30 deg (none: the slowest): a
     # stroke whose slowest tempo is too slow to turn on lying down stands up there (the backstroke).
     wait_turn_tempo: float | None = Field(None, ge=0.1, le=1.5)
+    # ... and at least the tempo whose steady speed is this share of the target's pace (none: the
+    # slowest): a stroke that stalls at its slowest tempo (the breaststroke) is left standing.
+    wait_pace: float | None = Field(None, gt=0.0, le=1.0)
     # ... and only within this of the depth it steers for (none: at any depth): a stroke that rides
     # up at its slowest tempo (the breaststroke) dives on instead of waiting above a diving path.
     wait_depth_within_m: float | None = Field(None, gt=0.0, le=10.0)
