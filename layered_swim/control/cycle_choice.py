@@ -383,18 +383,18 @@ class TargetChooser:
         drive = 0.0 if waiting else self.tempo_control.drive(distance, heading_error)
         # Levelling off, kick at the level-off tempo even for a target behind: a fast kick lies it down sooner.
         tempo = self.level_off_tempo if self._levelling else self.tempo_control.tempo_for(drive)
+        # The target's pace where the swimmer is along its path (only a known path has one).
+        pace_m_s = target_speed_m_s(path, state.time_s + max(0.0, ahead_of_target_s), STEP_S) if foresight else 0.0
         if self.tempo_control.keep_pace and not waiting and foresight:
-            speed_m_s = target_speed_m_s(path, state.time_s + max(0.0, ahead_of_target_s), STEP_S)
-            tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(speed_m_s)))
+            tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(pace_m_s)))
             if self.tempo_control.close_gap_s is not None and stays_at_surface(path, state.time_s, self._surface_z_m()):
-                closing = self.tempo_control.closing_speed_m_s(speed_m_s, behind_along_m(path, state.time_s, position))
+                closing = self.tempo_control.closing_speed_m_s(pace_m_s, behind_along_m(path, state.time_s, position))
                 fastest = self.tempo_control.turn_tempo or 1.0
                 tempo = max(tempo, min(fastest, self.table.pace.tempo_for_speed(closing)))
         if waiting:
             pace_tempo = None
             if self.tempo_control.wait_pace is not None:
-                speed_m_s = target_speed_m_s(path, state.time_s + ahead_of_target_s, STEP_S)
-                pace_tempo = min(1.0, self.table.pace.tempo_for_speed(self.tempo_control.wait_pace * speed_m_s))
+                pace_tempo = min(1.0, self.table.pace.tempo_for_speed(self.tempo_control.wait_pace * pace_m_s))
             tempo = self.tempo_control.waiting_tempo(tempo, heading_error, pace_tempo)
         else:
             tempo = self.tempo_control.turning_tempo(tempo, heading_error, ahead_of_target_s)
