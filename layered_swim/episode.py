@@ -239,7 +239,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                     catch_up_beyond_m=steer.catch_up_beyond_m, dive_tempo=steer.dive_tempo,
                                     close_gap_s=steer.close_gap_s, wait_turn_tempo=steer.wait_turn_tempo,
                                     wait_pace=steer.wait_pace)
-                lead = Lead(bend_s=steer.lead_bend_s, wait_ahead_s=steer.wait_ahead_s,
+                lead = Lead(straight_s=steer.lead_straight_s, bend_s=steer.lead_bend_s,
+                            diving_straight_s=steer.lead_straight_diving_s, wait_ahead_s=steer.wait_ahead_s,
                             wait_within_m=steer.wait_within_m, wait_depth_within_m=steer.wait_depth_within_m,
                             aim_off=steer.aim_off)
             gains = SteeringGains(steer.yaw_fraction, *pitch_roll,

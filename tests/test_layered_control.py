@@ -566,6 +566,18 @@ def test_lead_looks_further_ahead_where_the_path_bends():
     assert lead.seconds(FixedTarget((3.0, 0.0, -0.3)), 0.0) == pytest.approx(1.5)
     assert lead.seconds(load_trajectory("straight_line"), 5.0) == pytest.approx(1.5)
     assert lead.seconds(load_trajectory("circle"), 5.0) > 2.0      # a circle keeps turning
+    # A stroke may look further where the path runs straight, and less far where it dives.
+    longer = Lead(straight_s=2.5, bend_s=3.5, diving_straight_s=1.5)
+    assert longer.seconds(load_trajectory("straight_line"), 5.0) == pytest.approx(2.5)
+    assert longer.seconds(load_trajectory("straight_line"), 5.0, diving=True) == pytest.approx(1.5)
+    assert Lead(straight_s=2.5).seconds(load_trajectory("straight_line"), 5.0, diving=True) == pytest.approx(2.5)
+    # ... 1 m (2 s) behind a target on the straight line (x = 2 + 0.5 t): 2.5 s past it at x = 5.25,
+    # but at the depth the target reaches depth_ahead_s (1.5 s) on, whatever the look.
+    aim, ahead_s, _ = longer.aim(load_trajectory("straight_line"), 4.0, np.array([3.0, 0.0, -0.3]))
+    assert ahead_s == pytest.approx(-2.0) and aim == pytest.approx([5.25, 0.0, -0.3])
+    dive = TrajectoryTarget(np.array([[0.0, 0.0, -0.3], [2.0, 0.0, -4.3]]), np.array([0.0, 8.0]), 1.0, False)
+    assert longer.aim(dive, 0.0, np.array([0.0, 0.0, -0.3]), diving=True)[0] == pytest.approx([0.375, 0.0, -1.05])
+    assert longer.aim(dive, 0.0, np.array([0.0, 0.0, -0.3]))[0] == pytest.approx([0.625, 0.0, -1.05])
 
 
 def test_lead_aims_from_the_swimmers_own_place_on_the_path_when_it_is_ahead():

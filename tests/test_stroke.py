@@ -88,6 +88,8 @@ def test_shipped_strokes_load(name):
     (GOOD + "steering: {level_off_pitch_down_weight: 2}\n", ["steering.level_off_pitch_down_weight", "pitch_down"]),
     (GOOD + "steering: {level_off_pitch_down_weight: 4}\n", ["steering.level_off_pitch_down_weight"]),
     (GOOD + "steering: {under_water_below_m: 0.6}\n", ["steering.under_water_below_m", "under_water"]),
+    (GOOD + "steering: {lead_straight_s: 4}\n", ["steering", "lead_bend_s (3 s) must be at least lead_straight_s"]),
+    (GOOD + "steering: {lead_straight_diving_s: 5, lead_bend_s: 4}\n", ["steering", "lead_bend_s (4 s)", "(5 s)"]),
     (GOOD + "trim: {joints: {elbow_l: {flexion: 10}}}\n", ["trim.joints", "elbow_l.flexion", "range"]),
     (GOOD + "trim: {joints: {tail: {flexion: 10}}}\n", ["trim.joints.tail", "unknown joint"]),
     (GOOD + "trim: {light_from: 0.9, light_full: 0.95}\n", ["trim", "light_full < light_from"]),

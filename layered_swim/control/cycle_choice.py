@@ -202,6 +202,10 @@ class Lead:
 
     straight_s: float = 1.5
     bend_s: float = 3.0         # strokes set their own (``steering.lead_bend_s``): the turns they can make
+    # Where the target is under water or its path dives soon (``stays_at_surface``), aim this far
+    # ahead where the path runs straight (None: ``straight_s``).
+    diving_straight_s: float | None = None
+    depth_ahead_s: float = 1.5      # the depth steered for is the target's this far ahead
     full_bend_rad: float = math.radians(60.0)   # the path's change of direction over bend_s that earns all of it
     search_s: float = 6.0       # how far along the path, either way from the target, to look for the swimmer
     wait_ahead_s: float = 0.5   # ahead of the target by more than this along its path: slow down
@@ -230,17 +234,19 @@ class Lead:
         nearest = int(np.argmin([float(np.linalg.norm(p)) for p in points]))
         return float(times_s[nearest]), math.hypot(points[nearest][0], points[nearest][1])
 
-    def aim(self, target: Target, time_s: float, position_m: np.ndarray) -> tuple[np.ndarray, float, float]:
+    def aim(self, target: Target, time_s: float, position_m: np.ndarray,
+            diving: bool = False) -> tuple[np.ndarray, float, float]:
         """The point to steer for, how many seconds the swimmer is ahead of the target along its
         path (< 0 behind) and how far off the path it is. Behind, it aims ahead of the target;
         ahead (it cut a corner or a current carried it), it aims ahead of its own place on the
-        path, not back at the target: swimming back to a target that comes toward it only circles it."""
+        path, not back at the target: swimming back to a target that comes toward it only circles it.
+        ``diving``: the target is under water or its path dives soon."""
         place_s, off_path_m = self.place_on_path_s(target, time_s, position_m)
         from_s = max(time_s, place_s)
-        aim_m = np.array(target.position(from_s + self.seconds(target, from_s)), dtype=float)
-        # ... but at the depth the target itself reaches straight_s from now: a swimmer ahead along a
-        # diving path held the path's depth there and left a hold early, and one behind dived late.
-        aim_m[2] = target.position(time_s + self.straight_s)[2]
+        aim_m = np.array(target.position(from_s + self.seconds(target, from_s, diving)), dtype=float)
+        # ... but at the depth the target itself reaches depth_ahead_s from now: a swimmer ahead along
+        # a diving path held the path's depth there and left a hold early, and one behind dived late.
+        aim_m[2] = target.position(time_s + self.depth_ahead_s)[2]
         return aim_m, place_s - time_s, off_path_m
 
     def waits(self, ahead_of_target_s: float, off_path_m: float, depth_off_m: float = 0.0) -> bool:
@@ -249,11 +255,14 @@ class Lead:
         return (ahead_of_target_s > self.wait_ahead_s and off_path_m <= self.wait_within_m
                 and (self.wait_depth_within_m is None or depth_off_m <= self.wait_depth_within_m))
 
-    def seconds(self, target: Target, time_s: float) -> float:
+    def seconds(self, target: Target, time_s: float, diving: bool = False) -> float:
+        """How far ahead to aim: ``straight_s`` (diving: ``diving_straight_s``) where the path runs
+        straight, up to ``bend_s`` where it bends by ``full_bend_rad`` or more."""
+        straight_s = self.diving_straight_s if diving and self.diving_straight_s is not None else self.straight_s
         now, later = _step_m(target, time_s), _step_m(target, time_s + self.bend_s)
         norms = float(np.linalg.norm(now) * np.linalg.norm(later))
         bend = math.acos(max(-1.0, min(1.0, float(now @ later) / norms))) if norms > 1e-12 else 0.0
-        return self.straight_s + (self.bend_s - self.straight_s) * min(1.0, bend / self.full_bend_rad)
+        return straight_s + (self.bend_s - straight_s) * min(1.0, bend / self.full_bend_rad)
 
 
 class Drift:
@@ -348,8 +357,9 @@ class TargetChooser:
         foresight = getattr(self.target, "foresight", True)
         current = self._current_m_s(position, state.time_s)
         path = InWater(self.target, current, state.time_s) if foresight and current.any() else self.target
+        at_surface = foresight and stays_at_surface(path, state.time_s, self._surface_z_m())
         if foresight:
-            target, ahead_of_target_s, off_path_m = self.lead.aim(path, state.time_s, position)
+            target, ahead_of_target_s, off_path_m = self.lead.aim(path, state.time_s, position, not at_surface)
         else:
             target, ahead_of_target_s, off_path_m = self.target.position(state.time_s), 0.0, 0.0
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); pitch and
@@ -387,7 +397,7 @@ class TargetChooser:
         pace_m_s = target_speed_m_s(path, state.time_s + max(0.0, ahead_of_target_s), STEP_S) if foresight else 0.0
         if self.tempo_control.keep_pace and not waiting and foresight:
             tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(pace_m_s)))
-            if self.tempo_control.close_gap_s is not None and stays_at_surface(path, state.time_s, self._surface_z_m()):
+            if self.tempo_control.close_gap_s is not None and at_surface:
                 closing = self.tempo_control.closing_speed_m_s(pace_m_s, behind_along_m(path, state.time_s, position))
                 fastest = self.tempo_control.turn_tempo or 1.0
                 tempo = max(tempo, min(fastest, self.table.pace.tempo_for_speed(closing)))

@@ -129,9 +129,13 @@ class SteeringSpec(Strict):
     # At least this tempo while the point steered for lies more than 0.3 m below (none: any): a
     # stroke that lies nose-up when slow cannot pitch down far enough to dive at its pace.
     dive_tempo: float | None = Field(None, ge=0.5, le=1.5)
-    # On a moving target's known path: aim this far ahead where it bends (1.5 s where it runs
-    # straight), and wait (slowest tempo, or glide) when more than wait_ahead_s ahead of it.
-    lead_bend_s: float = Field(3.0, ge=1.5, le=10.0)
+    # On a moving target's known path: aim lead_straight_s ahead of it where it runs straight (while
+    # the target is under water or its path dives within 20 s: lead_straight_diving_s, none: the
+    # same), up to lead_bend_s where it bends, and wait (slowest tempo, or glide) when more than
+    # wait_ahead_s ahead of it.
+    lead_straight_s: float = Field(1.5, ge=0.5, le=10.0)
+    lead_straight_diving_s: float | None = Field(None, ge=0.5, le=10.0)
+    lead_bend_s: float = Field(3.0, ge=0.5, le=10.0)
     wait_ahead_s: float = Field(0.5, ge=0.0, le=10.0)
     # ... and only within this of the path (farther off, swim back to it; a stroke that follows
     # loosely waits from farther).
@@ -182,6 +186,14 @@ class SteeringSpec(Strict):
     # (none: never): under water a swimmer does not lift its head to breathe, and that lift rose the
     # breaststroke from 3 m with empty lungs.
     under_water_below_m: float | None = Field(None, gt=0.0, le=20.0)
+
+    @model_validator(mode="after")
+    def _lead_ordered(self):
+        straight_s = max(self.lead_straight_s, self.lead_straight_diving_s or 0.0)
+        if self.lead_bend_s < straight_s:
+            raise ValueError(f"lead_bend_s ({self.lead_bend_s:g} s) must be at least lead_straight_s and "
+                             f"lead_straight_diving_s ({straight_s:g} s): a bend is aimed at no nearer")
+        return self
 
 
 class TrimSpec(Strict):
