@@ -197,8 +197,9 @@ def stays_at_surface(target: Target, time_s: float, surface_z_m: float) -> bool:
 @dataclass(frozen=True)
 class Lead:
     """How far ahead in time to aim at a moving target. Where its path runs straight, a short
-    look keeps a sideways error (a cross current's drift) corrected hard; where the path bends,
-    a long one starts the turn early, as turning takes cycles."""
+    look keeps a sideways error (a cross current's drift) corrected hard, but one shorter than a
+    cycle's travel snakes (strokes set their own: ``steering.lead_straight_s``); where the path
+    bends, a long one starts the turn early, as turning takes cycles."""
 
     straight_s: float = 1.5
     bend_s: float = 3.0         # strokes set their own (``steering.lead_bend_s``): the turns they can make
