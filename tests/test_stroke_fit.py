@@ -54,14 +54,20 @@ def test_a_yaw_sequence_s_turning_circle_is_its_distance_a_cycle_over_its_turn_a
     period_s = 1.517                                                 # strokes/breaststroke.yaml
     drift, speed_m_s, *_, straight_m = calibration_swim(("breaststroke", None, 0.0, 1.0))
     assert straight_m == pytest.approx(speed_m_s * period_s, rel=0.01)
-    change, chord_speed_m_s, *_, turning_m = calibration_swim(("breaststroke", "yaw_left", 1.0, 1.0))
+    turning = calibration_swim(("breaststroke", "yaw_left", 1.0, 1.0))
+    change, chord_speed_m_s, roll_rad, pitch_rad, _, turning_m = turning
     turn_rad = change - drift[0]
     assert turn_rad > 0.3 and turning_m < straight_m                  # a full turn slows it
     assert chord_speed_m_s * period_s == pytest.approx(turning_m * math.sin(turn_rad) / turn_rad, rel=0.02)
     turns = stroke_fit.full_weight_turns("breaststroke", period_s)
     assert turns["yaw_left_radius_m"] == pytest.approx(turning_m / turn_rad)
     assert turns["yaw_left_deg_per_s"] == pytest.approx(math.degrees(turn_rad) / period_s)
-    assert set(turns) == {"yaw_left_deg_per_s", "yaw_right_deg_per_s", "yaw_left_radius_m", "yaw_right_radius_m"}
+    # ... and how fast along the track, and pitched and rolled how far, while it turns
+    assert turns["yaw_left_speed_m_s"] == pytest.approx(turning_m / period_s)
+    assert turns["yaw_left_pitch_deg"] == pytest.approx(math.degrees(pitch_rad))
+    assert turns["yaw_left_roll_deg"] == pytest.approx(math.degrees(roll_rad))
+    assert set(turns) == {f"yaw_{side}_{figure}" for side in ("left", "right")
+                          for figure in ("deg_per_s", "radius_m", "speed_m_s", "pitch_deg", "roll_deg")}
 
 
 def test_rest_knobs_set_a_held_angle_only_where_no_key_sets_it(tmp_path):

@@ -64,8 +64,10 @@ BEST_STROKE = "best.yaml"
 BEST = "best.json"
 RESOLVED = "fit.json"
 NOT_MEASURED_PENALTY = 100.0        # a candidate that blew up, did not cycle, or lacks a targeted figure
-# Each yaw sequence at weight 1, tempo 1: how fast it turns, and how tight (the radius of its circle).
-TURNS = ("yaw_left_deg_per_s", "yaw_right_deg_per_s", "yaw_left_radius_m", "yaw_right_radius_m")
+# Each yaw sequence at weight 1, tempo 1: how fast it turns, how tight (the radius of its circle),
+# and its speed, pitch and roll there.
+TURNS = tuple(f"{sequence}_{figure}" for sequence in ("yaw_left", "yaw_right")
+              for figure in ("deg_per_s", "radius_m", "speed_m_s", "pitch_deg", "roll_deg"))
 FIGURES = (*QUANTITIES, "active_drag_x_narita", *TURNS)
 REST = re.compile(r"^rest\.(?P<joint>\w+)\.(?P<axis>\w+)$")
 KNOB = re.compile(r"^(?:(?P<seq>\w+)/)?(?P<joint>\w+)\.(?P<axis>\w+)(?:\[(?P<index>\d+)\])?"
@@ -338,14 +340,20 @@ def full_weight_turns(path: str, period_s: float) -> dict[str, float | None]:
     """How fast each yaw sequence turns the swimmer at full weight and tempo 1, as ``calibrate``
     measures it (its turn per cycle less the unperturbed drift), per second: a slower stroke
     turns less often, and steering needs turns per second; and how tight: the radius of the
-    circle it swims (distance per cycle over turn per cycle; None where it turns the other way)."""
+    circle it swims (distance per cycle over turn per cycle; None where it turns the other way);
+    and how it swims there: its speed along the track and its last cycle's mean pitch and shoulder
+    roll (a turn that stands the swimmer up or rolls it over tightens its circle by stalling, and
+    steering then takes it for stood up or rolled over)."""
     drift = calibration_swim((path, None, 0.0, 1.0))[0][AXIS_INDEX["yaw"]]
     out = {}
     for sequence in ("yaw_left", "yaw_right"):
-        change, *_, per_cycle_m = calibration_swim((path, sequence, 1.0, 1.0))
+        change, _, roll_rad, pitch_rad, _, per_cycle_m = calibration_swim((path, sequence, 1.0, 1.0))
         turn_rad = SEQUENCE_AXIS[sequence][1] * (change - drift)
         out[f"{sequence}_deg_per_s"] = math.degrees(turn_rad) / period_s
         out[f"{sequence}_radius_m"] = per_cycle_m / turn_rad if turn_rad > 0.0 else None
+        out[f"{sequence}_speed_m_s"] = per_cycle_m / period_s
+        out[f"{sequence}_pitch_deg"] = math.degrees(pitch_rad)
+        out[f"{sequence}_roll_deg"] = math.degrees(roll_rad)
     return out
 
 
