@@ -39,6 +39,7 @@ from layered_swim.control.auto import AUTO, AUTO_STROKES, AutoStrokeController
 from layered_swim.control.basic import StrokeController
 from layered_swim.control.calibration import load_table
 from layered_swim.control.cycle_choice import Lead, TargetChooser, TempoControl, Water
+from layered_swim.control.depth_hold import DepthHold
 from layered_swim.control.layered import CycleChooser, LayeredController, Layers, fixed_weights
 from layered_swim.control.lungs import LungControl
 from layered_swim.control.rules import arm_indices
@@ -224,8 +225,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
     if weights is None and target is None:
         return StrokeController(stroke, tempo)
     goal_line = tempo_control is not None
+    steer = stroke.steering
     if weights is None:
-        steer = stroke.steering
         if layers.cycle:
             # A task with its own tempo control (the goal line) keeps the default aim, and steers the
             # heading only (no pitch, roll or breath): the shipped residuals were trained on that.
@@ -266,4 +267,7 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                          deep_below_m=stroke.steering.under_water_below_m or 0.0,
                          deep_air_l=stroke.steering.under_water_air_l)
              if stroke.steering.breathe and not goal_line else None)
-    return LayeredController(stroke, layout, arm_indices(body, layout), weights, layers, target, lungs)
+    depth_hold = (DepthHold(steer.under_water_pitch_per_m, steer.under_water_pitch_per_m_s,
+                            steer.under_water_depth_ahead_s)
+                  if steer.under_water_pitch_per_m is not None and not goal_line else None)
+    return LayeredController(stroke, layout, arm_indices(body, layout), weights, layers, target, lungs, depth_hold)

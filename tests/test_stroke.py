@@ -88,6 +88,8 @@ def test_shipped_strokes_load(name):
     (GOOD + "steering: {level_off_pitch_down_weight: 2}\n", ["steering.level_off_pitch_down_weight", "pitch_down"]),
     (GOOD + "steering: {level_off_pitch_down_weight: 4}\n", ["steering.level_off_pitch_down_weight"]),
     (GOOD + "steering: {under_water_below_m: 0.6}\n", ["steering.under_water_below_m", "under_water"]),
+    (GOOD + "steering: {under_water_pitch_per_m: 3}\n", ["steering.under_water_pitch_per_m", "under_water_below_m"]),
+    (GOOD + "steering: {under_water_pitch_per_m: -1}\n", ["steering.under_water_pitch_per_m"]),
     (GOOD + "steering: {lead_straight_s: 4}\n", ["steering", "lead_bend_s (3 s) must be at least lead_straight_s"]),
     (GOOD + "steering: {lead_straight_diving_s: 5, lead_bend_s: 4}\n", ["steering", "lead_bend_s (4 s)", "(5 s)"]),
     (GOOD + "trim: {joints: {elbow_l: {flexion: 10}}}\n", ["trim.joints", "elbow_l.flexion", "range"]),

@@ -6,7 +6,8 @@ the cycle's tempo); the weights scale and blend the sequences' offsets into the 
 for that whole cycle. Every control step the continuous rules adjust the blended pose from the
 water flowing past the hands. Layers can be switched off one by one (``Layers``). A stroke that
 breathes to steer (``steering.breathe``) also sets the air in the lungs toward the target's depth
-(``control/lungs.py``); the simulation hands it to the fluid.
+(``control/lungs.py``); the simulation hands it to the fluid. Under water a stroke may move its
+pitch weights every step toward the target's depth (``control/depth_hold.py``).
 """
 from __future__ import annotations
 
@@ -16,10 +17,11 @@ from typing import Protocol
 import numpy as np
 
 from layered_swim.config import ConfigError
+from layered_swim.control.depth_hold import DepthHold, with_pitch_added
 from layered_swim.control.lungs import LungControl
 from layered_swim.control.rules import Arms, rule_offsets
 from layered_swim.control.steering import MeanAttitude, elevation, forward_axis, shoulder_roll
-from layered_swim.control.stroke import ALL_SEQUENCES, Stroke
+from layered_swim.control.stroke import ALL_SEQUENCES, UNDER_WATER, Stroke
 from layered_swim.control.targets import Target, target_velocity_m_s
 from layered_swim.geometry import ease, unit_vector
 from layered_swim.state import BodyState, JointLayout
@@ -71,12 +73,16 @@ class CycleChooser(Protocol):
 
 class LayeredController:
     def __init__(self, stroke: Stroke, layout: JointLayout, arms: Arms, chooser: CycleChooser,
-                 layers: Layers = Layers(), target: Target | None = None, lungs: LungControl | None = None):
+                 layers: Layers = Layers(), target: Target | None = None, lungs: LungControl | None = None,
+                 depth_hold: DepthHold | None = None):
         """``target``: where the rules push toward; without one, straight ahead (scripted weights).
-        ``lungs``: breathe toward the target's depth (needs a target)."""
+        ``lungs``: breathe toward the target's depth (needs a target). ``depth_hold``: while the
+        cycle takes the ``under_water`` sequence, move the pitch weights every step toward the
+        target's depth (needs a target)."""
         self.stroke, self.layout, self.arms, self.chooser, self.layers = stroke, layout, arms, chooser, layers
         self.target = target
         self.lungs = lungs if target is not None else None
+        self.depth_hold = depth_hold if target is not None else None
         self.reset()
 
     def reset(self) -> None:
@@ -137,7 +143,11 @@ class LayeredController:
             moving = self.stroke.glide_moving
             pose = np.where(moving, running, pose)
             rate = np.where(moving, running_rate, 0.0)
-        for name, weight in self._blended_weights(time_s).items():
+        weights = self._blended_weights(time_s)
+        if self.depth_hold is not None and state is not None and UNDER_WATER in self.choice.weights:
+            weights = with_pitch_added(weights, self.depth_hold.weight_toward(
+                self.target, time_s, float(state.pos("pelvis")[2]), float(state.com_vel_m_s[2])))
+        for name, weight in weights.items():
             if weight:
                 pose, rate = self.stroke.perturbations[name].added(pose, rate, weight, phase)
         if state is not None:

@@ -186,6 +186,13 @@ class SteeringSpec(Strict):
     # (none: never): under water a swimmer does not lift its head to breathe, and that lift rose the
     # breaststroke from 3 m with empty lungs.
     under_water_below_m: float | None = Field(None, gt=0.0, le=20.0)
+    # ... and while it does, every control step its net pitch weight (+: pitch_down) moves by this
+    # much per metre the pelvis lies above the target's depth under_water_depth_ahead_s on, plus
+    # under_water_pitch_per_m_s per m/s it rises faster than that target (none: never;
+    # control/depth_hold.py)
+    under_water_pitch_per_m: float | None = Field(None, gt=0.0, le=20.0)
+    under_water_pitch_per_m_s: float = Field(0.0, ge=0.0, le=20.0)
+    under_water_depth_ahead_s: float = Field(0.0, ge=0.0, le=10.0)
 
     @model_validator(mode="after")
     def _lead_ordered(self):
@@ -454,6 +461,9 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
             raise ConfigError(f"{source}: field 'pd_gain_scale.{joint}': unknown joint")
     if spec.steering.under_water_below_m is not None and UNDER_WATER not in spec.perturbations:
         raise ConfigError(f"{source}: field 'steering.under_water_below_m': the stroke has no {UNDER_WATER} sequence")
+    if spec.steering.under_water_pitch_per_m is not None and spec.steering.under_water_below_m is None:
+        raise ConfigError(f"{source}: field 'steering.under_water_pitch_per_m': needs "
+                          f"steering.under_water_below_m (it acts only under water)")
     if spec.steering.level_off_pitch_down_weight is not None and PITCH_DOWN not in spec.perturbations:
         raise ConfigError(f"{source}: field 'steering.level_off_pitch_down_weight': the stroke has no "
                           f"{PITCH_DOWN} sequence")
