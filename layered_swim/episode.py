@@ -259,7 +259,10 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                     level_off_pitch_down_weight=(None if goal_line
                                                                  else steer.level_off_pitch_down_weight),
                                     recover_beyond_rad=recover, water=None if goal_line else water,
-                                    under_water_below_m=None if goal_line else steer.under_water_below_m)
+                                    under_water_below_m=None if goal_line else steer.under_water_below_m,
+                                    under_water_level_pitch_rad=(
+                                        None if goal_line or steer.under_water_level_pitch_deg is None
+                                        else math.radians(steer.under_water_level_pitch_deg)))
         else:
             weights = fixed_weights({}, tempo=tempo)
     lungs = (LungControl(body.lung_air_l, body.max_lung_air_l, breathe_out=stroke.steering.breathe_out,

@@ -1,4 +1,5 @@
 """The per-cycle layer (weights, blending, calibration inversion), the rules and a short follow."""
+import dataclasses
 import math
 
 import numpy as np
@@ -831,6 +832,29 @@ def test_a_stroke_aiming_under_water_takes_its_under_water_sequence_at_full_weig
         stood = MeanAttitude(math.radians(40.0), 0.0)
         assert recovering(1, state, stood).weights == ({UNDER_WATER: 1.0} if under else {})
     assert UNDER_WATER not in TargetChooser(FixedTarget((5.0, 0.0, -2.0)), table(), "prone")(0, state, None).weights
+
+
+def test_under_water_the_pitch_correction_steers_for_the_under_water_level():
+    """A pace table lying 10 deg nose-up (as a slow breaststroke does at the surface): a level body
+    2 m down, toward a target at its depth, is pitched up toward it (half the error, 5 deg: pitch-up
+    0.5) unless the chooser has a level of its own under water (0 deg: no error); at the surface the
+    table's pitch holds either way."""
+    t = attitude_table()
+    nose_up = dataclasses.replace(t, pace=Pace((0.5, 1.0), (0.4, 0.8), (0.0, 0.0), (math.radians(10.0),) * 2,
+                                               (0.2, 0.2)))
+    level = MeanAttitude(0.0, 0.0)
+    for depth_m in (2.0, 0.0):
+        base = still_state()
+        state = BodyState(0.0, base.pos_m + np.array([0.0, 0.0, -depth_m]), base.quat_xyzw, base.linvel_m_s,
+                          base.angvel_rad_s, base.segments)
+        target = FixedTarget((5.0, 0.0, -depth_m))
+        own = TargetChooser(target, nose_up, "prone", under_water_below_m=0.6, under_water_level_pitch_rad=0.0)
+        table_level = TargetChooser(target, nose_up, "prone", under_water_below_m=0.6)
+        mine, tables = own(0, state, level).weights, table_level(0, state, level).weights
+        assert (mine.get(UNDER_WATER), tables.get(UNDER_WATER)) == ((1.0, 1.0) if depth_m else (None, None))
+        assert mine.get("pitch_up", 0.0) == pytest.approx(0.0 if depth_m else 0.5)
+        assert mine.get("pitch_down", 0.0) == pytest.approx(0.0, abs=1e-9)
+        assert tables.get("pitch_up") == pytest.approx(0.5)
 
 
 def test_a_stroke_levels_off_with_its_pitch_down_sequence_overweighted_until_its_cycles_lie():

@@ -325,7 +325,8 @@ class TargetChooser:
                  level_off_beyond_rad: float | None = None, level_off_tempo: float = 1.0,
                  level_off_sequence: bool = True, level_off_pitch_down_weight: float | None = None,
                  recover_beyond_rad: tuple[float | None, float | None] = (None, None),
-                 water: Callable[[], Water] | None = None, under_water_below_m: float | None = None):
+                 water: Callable[[], Water] | None = None, under_water_below_m: float | None = None,
+                 under_water_level_pitch_rad: float | None = None):
         """``level_off_beyond_rad``: starting (cycle 0) pitched nose up by more than this beyond
         any climb toward the target, swim at ``level_off_tempo`` every cycle until neither the
         pitch as a cycle starts nor the last cycle's mean is (None: never), taking the stroke's
@@ -337,7 +338,9 @@ class TargetChooser:
         ``water()``: the water swum in now; a target on a known path is then steered for in the
         frame of the water's steady current where the swimmer is (``InWater``).
         ``under_water_below_m``: the stroke's ``under_water`` sequence at weight 1, on top of the
-        rest, while the point steered for lies deeper than this below the surface (None: never)."""
+        rest, while the point steered for lies deeper than this below the surface (None: never);
+        there the pitch correction steers to ``under_water_level_pitch_rad`` plus the glide angle
+        (None: to the pace table's pitch, which is the surface's)."""
         self.target, self.table, self.posture, self.lead = target, table, posture, lead
         self.water = water
         self.gains, self.tempo_control = gains, tempo
@@ -346,6 +349,7 @@ class TargetChooser:
         self.level_off_pitch_down_weight = level_off_pitch_down_weight
         self.recover_beyond_rad = recover_beyond_rad
         self.under_water_below_m = under_water_below_m
+        self.under_water_level_pitch_rad = under_water_level_pitch_rad
         self._levelling = False
         self._last_error_rad = 0.0      # the last cycle's heading error, as steered
         self.held_rad = {"pitch": 0.0, "roll": 0.0}     # the attitude offsets the sequences hold
@@ -468,6 +472,9 @@ class TargetChooser:
         the error, plus the proportional share of it (levelling off, the level-off sequence does
         the pitching)."""
         level = MeanAttitude(self.table.pace.pitch_at(tempo), self.table.pace.roll_at(tempo))
+        if self.under_water_level_pitch_rad is not None and self._under_water(target_m):
+            # The surface's pitch at a slow tempo is nose-up (+21 deg at 0.7): under water that climbs.
+            level = MeanAttitude(self.under_water_level_pitch_rad, level.roll_rad)
         errors = attitude_errors(mean, position_m, target_m, self.posture, level, self.gains)
         fractions = {"pitch": self.gains.pitch_fraction, "roll": self.gains.roll_fraction}
         weights = {}

@@ -191,6 +191,9 @@ class SteeringSpec(Strict):
     # under_water_pitch_per_m_s per m/s it rises faster than that target (none: never;
     # control/depth_hold.py)
     under_water_pitch_per_m: float | None = Field(None, gt=0.0, le=20.0)
+    # ... and its cycle-by-cycle pitch correction steers to this pitch there, not to the pitch its
+    # pace table gives at the surface (none: that one)
+    under_water_level_pitch_deg: float | None = Field(None, ge=-45.0, le=45.0)
     under_water_pitch_per_m_s: float = Field(0.0, ge=0.0, le=20.0)
     under_water_depth_ahead_s: float = Field(0.0, ge=0.0, le=10.0)
 
@@ -461,9 +464,10 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
             raise ConfigError(f"{source}: field 'pd_gain_scale.{joint}': unknown joint")
     if spec.steering.under_water_below_m is not None and UNDER_WATER not in spec.perturbations:
         raise ConfigError(f"{source}: field 'steering.under_water_below_m': the stroke has no {UNDER_WATER} sequence")
-    if spec.steering.under_water_pitch_per_m is not None and spec.steering.under_water_below_m is None:
-        raise ConfigError(f"{source}: field 'steering.under_water_pitch_per_m': needs "
-                          f"steering.under_water_below_m (it acts only under water)")
+    for name in ("under_water_pitch_per_m", "under_water_level_pitch_deg"):
+        if getattr(spec.steering, name) is not None and spec.steering.under_water_below_m is None:
+            raise ConfigError(f"{source}: field 'steering.{name}': needs steering.under_water_below_m "
+                              f"(it acts only under water)")
     if spec.steering.level_off_pitch_down_weight is not None and PITCH_DOWN not in spec.perturbations:
         raise ConfigError(f"{source}: field 'steering.level_off_pitch_down_weight': the stroke has no "
                           f"{PITCH_DOWN} sequence")
