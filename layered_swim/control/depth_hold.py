@@ -12,10 +12,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from layered_swim.control.stroke import PITCH_DOWN
+from layered_swim.control.stroke import PITCH_DOWN, PITCH_UP
 from layered_swim.control.targets import Target, target_velocity_m_s
 
-PITCH_UP = "pitch_up"
 RATE_STEP_S = 0.5     # the target's sinking rate from its move over this long, centred on the time read
 
 

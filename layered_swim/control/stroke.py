@@ -57,6 +57,7 @@ class StartSpec(Strict):
 
 # The steering sequences, each calibrated (turn per cycle against weight and tempo).
 SEQUENCE_NAMES = ("pitch_up", "pitch_down", "yaw_left", "yaw_right", "roll_left", "roll_right")
+PITCH_UP = "pitch_up"
 PITCH_DOWN = "pitch_down"     # also levels off a stroke set off standing up (``steering.level_off_pitch_down_weight``)
 # Lying down from upright (a lying stroke started from treading water): not calibrated, taken at
 # weight 1 in place of the pitch correction by a stroke that starts pitched up by more than
