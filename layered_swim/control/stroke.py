@@ -192,11 +192,11 @@ class SteeringSpec(Strict):
     # under_water_pitch_per_m_s per m/s it rises faster than that target (none: never;
     # control/depth_hold.py)
     under_water_pitch_per_m: float | None = Field(None, gt=0.0, le=20.0)
+    under_water_pitch_per_m_s: float = Field(0.0, ge=0.0, le=20.0)
+    under_water_depth_ahead_s: float = Field(0.0, ge=0.0, le=10.0)
     # ... and its cycle-by-cycle pitch correction steers to this pitch there, not to the pitch its
     # pace table gives at the surface (none: that one)
     under_water_level_pitch_deg: float | None = Field(None, ge=-45.0, le=45.0)
-    under_water_pitch_per_m_s: float = Field(0.0, ge=0.0, le=20.0)
-    under_water_depth_ahead_s: float = Field(0.0, ge=0.0, le=10.0)
 
     @model_validator(mode="after")
     def _lead_ordered(self):
