@@ -265,11 +265,10 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                         else math.radians(steer.under_water_level_pitch_deg)))
         else:
             weights = fixed_weights({}, tempo=tempo)
-    lungs = (LungControl(body.lung_air_l, body.max_lung_air_l, breathe_out=stroke.steering.breathe_out,
-                         damping_s=stroke.steering.breathe_damping_s,
-                         deep_below_m=stroke.steering.under_water_below_m or 0.0,
-                         deep_air_l=stroke.steering.under_water_air_l)
-             if stroke.steering.breathe and not goal_line else None)
+    lungs = (LungControl(body.lung_air_l, body.max_lung_air_l, breathe_out=steer.breathe_out,
+                         damping_s=steer.breathe_damping_s, deep_below_m=steer.under_water_below_m or 0.0,
+                         deep_air_l=steer.under_water_air_l)
+             if steer.breathe and not goal_line else None)
     depth_hold = (DepthHold(steer.under_water_pitch_per_m, steer.under_water_pitch_per_m_s,
                             steer.under_water_depth_ahead_s)
                   if steer.under_water_pitch_per_m is not None and not goal_line else None)
