@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from test_layered_control import still_state, table
 
-from layered_swim.analysis.robustness import spread
+from layered_swim.analysis.robustness import hold_spread, spread
 from layered_swim.control.cycle_choice import TargetChooser
 from layered_swim.control.targets import StationTarget
 from layered_swim.episode import START_JITTER, WIDE_JITTER, jittered_start
@@ -92,10 +92,40 @@ def test_follow_seeds_reports_medians_over_perturbed_starts(tmp_path):
     assert distances[0] != distances[1]                       # two different starts
     assert summary["median"]["mean_distance_m"]["median"] == pytest.approx(np.median(distances))
     assert summary["reached_all_share"] == 0.0                # 4 m away, one second
+    assert "holds" not in summary                             # its target never changes depth
     assert json.loads((out / "summary.json").read_text())["runs"] == summary["runs"]
     refused = subprocess.run([sys.executable, "-m", "layered_swim", "follow", "jumping", "--seconds", "1",
                               "--seeds", "2", "--backend", "sph"], capture_output=True, text=True, timeout=300)
     assert refused.returncode == 2 and refused.stderr.count("\n") == 1 and "--seeds" in refused.stderr
+
+
+def _hold(z_m, from_s, to_s, max_error_m, above_m):
+    return {"target_z_m": z_m, "from_s": from_s, "to_s": to_s, "mean_error_m": abs(above_m),
+            "max_error_m": max_error_m, "max_error_at_s": from_s, "mean_above_m": above_m}
+
+
+def test_the_holds_over_many_starts_say_which_one_misses_and_how_often():
+    """Three starts of a path holding 0.3 m then 4 m; the third was cut short before the deep hold."""
+    runs = [{"holds": [_hold(-0.3, 0, 10, 0.20, 0.10), _hold(-4.0, 30, 40, 0.50, -0.20)]},
+            {"holds": [_hold(-0.3, 0, 10, 0.30, 0.12), _hold(-4.0, 30, 40, 0.25, 0.04)]},
+            {"holds": [_hold(-0.3, 0, 10, 0.28, 0.08)]}]
+    shallow, deep = hold_spread(runs)
+    assert (shallow["target_z_m"], shallow["from_s"], shallow["to_s"]) == (-0.3, 0, 10)
+    assert shallow["max_error_m"] == {"median": 0.28, "min": 0.20, "max": 0.30}
+    assert shallow["mean_above_m"] == pytest.approx(0.10)
+    assert deep["max_error_m"] == {"median": pytest.approx(0.375), "min": 0.25, "max": 0.50}   # two runs reached it
+    assert deep["mean_above_m"] == pytest.approx(-0.08)
+    assert (shallow["worst_in_runs"], deep["worst_in_runs"]) == (2, 1)
+    assert hold_spread([{"holds": []}, {}]) == []
+
+
+def test_follow_seeds_prints_each_hold(tmp_path):
+    """The deep dive's target holds 0.3 m for 10 s, then dives: one hold in 11 s."""
+    run = subprocess.run([sys.executable, "-m", "layered_swim", "follow", "deep_dive", "--seconds", "11", "--seeds",
+                          "2", "--workers", "2", "--out", str(tmp_path / "seeds")],
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert "hold 1 (z -0.30 m, 0.0-" in run.stdout and "the worst hold in 2 of 2 starts" in run.stdout
 
 
 def test_the_summary_says_which_stroke_swam_when():

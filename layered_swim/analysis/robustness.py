@@ -29,7 +29,7 @@ def follow_one(config: dict) -> dict:
     """One perturbed run (module level: worker processes pickle it): ``config`` is a SwimSpec's dump."""
     spec = SwimSpec.model_validate(config)
     result = follow_run(spec, steering=steering_for(spec))
-    return {k: v for k, v in result.items() if k in HEADLINES or k in ("seed", "reached_all", "stations")}
+    return {k: v for k, v in result.items() if k in HEADLINES or k in ("seed", "reached_all", "stations", "holds")}
 
 
 def spread(values: list) -> dict | None:
@@ -40,6 +40,23 @@ def spread(values: list) -> dict | None:
     x = np.array([math.inf if v is None else float(v) for v in values])
     finite = lambda v: float(v) if math.isfinite(v) else None     # noqa: E731
     return {"median": finite(np.median(x)), "min": finite(x.min()), "max": finite(x.max())}
+
+
+def hold_spread(runs: list[dict]) -> list[dict]:
+    """Per stretch the target holds a depth (the same stretches in every run: only the start moves;
+    a run cut short has fewer), the spread of its largest depth error over the runs that reached
+    it, the median of how far the pelvis stayed above it, and in how many runs it was the worst
+    hold: which part of a path misses, and how often."""
+    held = [r["holds"] for r in runs if r.get("holds")]
+    if not held:
+        return []
+    worst = [max(range(len(h)), key=lambda k: h[k]["max_error_m"]) for h in held]
+    stretches = max(held, key=len)
+    return [{"target_z_m": first["target_z_m"], "from_s": first["from_s"], "to_s": first["to_s"],
+             "max_error_m": spread([h[k]["max_error_m"] for h in held if len(h) > k]),
+             "mean_above_m": float(np.median([h[k]["mean_above_m"] for h in held if len(h) > k])),
+             "worst_in_runs": worst.count(k)}
+            for k, first in enumerate(stretches)]
 
 
 def follow_seeds(spec: SwimSpec, seeds: int = 10, out_dir: OutputFolder | str | Path | None = None,
@@ -63,6 +80,8 @@ def follow_seeds(spec: SwimSpec, seeds: int = 10, out_dir: OutputFolder | str | 
     summary = {**common, "seeds": seeds, "start_jitter": asdict(WIDE_JITTER),
                "median": {k: s for k in HEADLINES if (s := spread([r.get(k) for r in runs])) is not None},
                "runs": runs}
+    if holds := hold_spread(runs):
+        summary["holds"] = holds
     if any("reached_all" in r for r in runs):
         summary["reached_all_share"] = float(np.mean([bool(r.get("reached_all")) for r in runs]))
     if out is not None:

@@ -91,6 +91,12 @@ def _follow_seeds(args, spec) -> None:
         return
     rows = [[k, *(fmt(v[q]) for q in ("median", "min", "max"))] for k, v in summary["median"].items()]
     print(table(rows, ["over " + str(args.seeds) + " starts", "median", "min", "max"]))
+    for n, hold in enumerate(summary.get("holds", []), 1):
+        error = hold["max_error_m"]
+        print(f"hold {n} (z {hold['target_z_m']:.2f} m, {hold['from_s']:.1f}-{hold['to_s']:.1f} s): largest depth "
+              f"error {error['median']:.2f} m median ({error['min']:.2f}-{error['max']:.2f}), pelvis "
+              f"{hold['mean_above_m']:+.2f} m above on average, the worst hold in {hold['worst_in_runs']} of "
+              f"{args.seeds} starts")
     if "reached_all_share" in summary:
         print(f"\nreached every station in {summary['reached_all_share']:.0%} of the runs")
     print(f"\nwrote summary.json (every run) and config.json to {out.path}")
