@@ -262,7 +262,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                     under_water_below_m=None if goal_line else steer.under_water_below_m,
                                     under_water_level_pitch_rad=(
                                         None if goal_line or steer.under_water_level_pitch_deg is None
-                                        else math.radians(steer.under_water_level_pitch_deg)))
+                                        else math.radians(steer.under_water_level_pitch_deg)),
+                                    under_water_yaw_fraction=None if goal_line else steer.under_water_yaw_fraction)
         else:
             weights = fixed_weights({}, tempo=tempo)
     lungs = (LungControl(body.lung_air_l, body.max_lung_air_l, breathe_out=steer.breathe_out,

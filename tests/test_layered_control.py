@@ -857,6 +857,23 @@ def test_under_water_the_pitch_correction_steers_for_the_under_water_level():
         assert tables.get("pitch_up") == pytest.approx(0.5)
 
 
+def test_under_water_the_heading_correction_takes_its_own_share_of_the_error():
+    """A target 8 deg to the left, at the body's depth: at the surface the chooser turns by 0.75 of
+    it (6 deg: yaw_left 0.75 on a table turning 8 deg at full weight); 2 m down by its under-water
+    share, 0.25 (2 deg: 0.25), and without one by 0.75 there too."""
+    gains = SteeringGains(yaw_fraction=0.75)
+    for depth_m, expected, without in ((0.0, 0.75, 0.75), (2.0, 0.25, 0.75)):
+        base = still_state()
+        state = BodyState(0.0, base.pos_m + np.array([0.0, 0.0, -depth_m]), base.quat_xyzw, base.linvel_m_s,
+                          base.angvel_rad_s, base.segments)
+        target = FixedTarget((5.0, 5.0 * math.tan(math.radians(8.0)), -depth_m))
+        own = TargetChooser(target, table(), "prone", gains=gains, under_water_below_m=0.6,
+                            under_water_yaw_fraction=0.25)
+        plain = TargetChooser(target, table(), "prone", gains=gains, under_water_below_m=0.6)
+        assert own(0, state, None).weights["yaw_left"] == pytest.approx(expected, abs=0.02)
+        assert plain(0, state, None).weights["yaw_left"] == pytest.approx(without, abs=0.02)
+
+
 def test_a_stroke_levels_off_with_its_pitch_down_sequence_overweighted_until_its_cycles_lie():
     """With ``level_off_pitch_down_weight``, levelling off takes the pitch-down sequence at that
     weight (not the correction's calibrated weights), and goes on while the last cycle's mean

@@ -326,7 +326,7 @@ class TargetChooser:
                  level_off_sequence: bool = True, level_off_pitch_down_weight: float | None = None,
                  recover_beyond_rad: tuple[float | None, float | None] = (None, None),
                  water: Callable[[], Water] | None = None, under_water_below_m: float | None = None,
-                 under_water_level_pitch_rad: float | None = None):
+                 under_water_level_pitch_rad: float | None = None, under_water_yaw_fraction: float | None = None):
         """``level_off_beyond_rad``: starting (cycle 0) pitched nose up by more than this beyond
         any climb toward the target, swim at ``level_off_tempo`` every cycle until neither the
         pitch as a cycle starts nor the last cycle's mean is (None: never), taking the stroke's
@@ -340,7 +340,8 @@ class TargetChooser:
         ``under_water_below_m``: the stroke's ``under_water`` sequence at weight 1, on top of the
         rest, while the point steered for lies deeper than this below the surface (None: never);
         there the pitch correction steers to ``under_water_level_pitch_rad`` plus the glide angle
-        (None: to the pace table's pitch, which is the surface's)."""
+        (None: to the pace table's pitch, which is the surface's), and the heading correction takes
+        ``under_water_yaw_fraction`` of the error a cycle (None: the gains' ``yaw_fraction``)."""
         self.target, self.table, self.posture, self.lead = target, table, posture, lead
         self.water = water
         self.gains, self.tempo_control = gains, tempo
@@ -350,6 +351,7 @@ class TargetChooser:
         self.recover_beyond_rad = recover_beyond_rad
         self.under_water_below_m = under_water_below_m
         self.under_water_level_pitch_rad = under_water_level_pitch_rad
+        self.under_water_yaw_fraction = under_water_yaw_fraction
         self._levelling = False
         self._last_error_rad = 0.0      # the last cycle's heading error, as steered
         self.held_rad = {"pitch": 0.0, "roll": 0.0}     # the attitude offsets the sequences hold
@@ -418,7 +420,7 @@ class TargetChooser:
         if not self._levelling:
             tempo = self.tempo_control.diving_tempo(tempo, float(position[2] - target[2]))
         self._last_error_rad = turn_error(att, position, target, self._last_error_rad)
-        yaw = self.gains.yaw_fraction * self._last_error_rad
+        yaw = self._yaw_fraction(target) * self._last_error_rad
         near = (distance < self.tempo_control.glide_within_m
                 and (not foresight or ahead_of_target_s > self.lead.glide_ahead_s))
         glide = ((near or (waiting and self.tempo_control.glide_within_m > 0))
@@ -449,6 +451,15 @@ class TargetChooser:
         return last_cycle is not None and (
             (pitch_rad is not None and last_cycle.pitch_rad > pitch_rad)
             or (roll_rad is not None and abs(last_cycle.roll_rad) > roll_rad))
+
+    def _yaw_fraction(self, aim_m: np.ndarray) -> float:
+        """The share of the heading error corrected this cycle. Under water a yaw weight turns the
+        breaststroke 1.5-2 times as far as the surface's table says, and correcting 75 % of the
+        error a cycle there swung its heading +-60 deg every ~9 s, and each hard turn rolled it
+        and moved its depth."""
+        if self.under_water_yaw_fraction is not None and self._under_water(aim_m):
+            return self.under_water_yaw_fraction
+        return self.gains.yaw_fraction
 
     def _under_water(self, aim_m: np.ndarray) -> dict[str, float]:
         """The under-water sequence's weight, by the depth of the point steered for (glides too)."""

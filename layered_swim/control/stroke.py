@@ -197,6 +197,9 @@ class SteeringSpec(Strict):
     # ... and its cycle-by-cycle pitch correction steers to this pitch there, not to the pitch its
     # pace table gives at the surface (none: that one)
     under_water_level_pitch_deg: float | None = Field(None, ge=-45.0, le=45.0)
+    # ... and corrects this share of its heading error a cycle there, not yaw_fraction (none: that
+    # one): its yaw sequences, sized by the surface's table, turn it further under water
+    under_water_yaw_fraction: float | None = Field(None, ge=0.0, le=1.0)
 
     @model_validator(mode="after")
     def _lead_ordered(self):
@@ -465,7 +468,7 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
             raise ConfigError(f"{source}: field 'pd_gain_scale.{joint}': unknown joint")
     if spec.steering.under_water_below_m is not None and UNDER_WATER not in spec.perturbations:
         raise ConfigError(f"{source}: field 'steering.under_water_below_m': the stroke has no {UNDER_WATER} sequence")
-    for name in ("under_water_pitch_per_m", "under_water_level_pitch_deg"):
+    for name in ("under_water_pitch_per_m", "under_water_level_pitch_deg", "under_water_yaw_fraction"):
         if getattr(spec.steering, name) is not None and spec.steering.under_water_below_m is None:
             raise ConfigError(f"{source}: field 'steering.{name}': needs steering.under_water_below_m "
                               f"(it acts only under water)")
