@@ -344,14 +344,13 @@ def test_a_gap_is_closed_only_on_a_path_that_stays_at_the_surface():
 def test_diving_swims_at_least_at_the_dive_tempo():
     """A target behind (the slowest tempo, turning round) and over 0.3 m below: a stroke with
     dive_tempo 1.0 swims at 1.0 (it lies flatter and pitches down further at speed); at its own
-    depth, ahead of the target along its path, or with no dive_tempo, at the slowest tempo."""
+    depth, well ahead of the target along its path, or with no dive_tempo, at the slowest tempo."""
     diving = TempoControl(dive_tempo=1.0)
     assert diving.diving_tempo(0.5, 0.31) == pytest.approx(1.0)
     assert diving.diving_tempo(0.5, 0.3) == pytest.approx(0.5)
     assert diving.diving_tempo(1.2, 1.0) == pytest.approx(1.2)
     assert TempoControl().diving_tempo(0.5, 1.0) == pytest.approx(0.5)
-    assert diving.diving_tempo(0.5, 1.0, ahead_s=0.5) == pytest.approx(0.5)     # ahead: it waits
-    assert diving.diving_tempo(0.5, 1.0, ahead_s=-0.5) == pytest.approx(1.0)
+    assert diving.diving_tempo(0.5, 1.0, well_ahead=True) == pytest.approx(0.5)     # it waits
     state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
     below, level = FixedTarget((-3.0, 0.0, -1.0)), FixedTarget((-3.0, 0.0, 0.0))
     assert TargetChooser(below, table(), "prone", tempo=diving)(0, state, None).tempo == pytest.approx(1.0)

@@ -74,8 +74,8 @@ class TempoControl:
     ``dive_tempo``: at least this tempo while the point steered for lies more than ``dive_below_m``
     below the centre of mass (a stroke that lies nose-up when slow cannot pitch down far enough to
     dive there: the breaststroke lies at 21 deg at tempo 0.7 and its pitch-down sequence takes it
-    only to -8 deg; at full tempo it lies at 9 deg and pitches to -14), but not while ahead of the
-    target along its path (the breaststroke dived at full tempo 1-2 m past a diving target)."""
+    only to -8 deg; at full tempo it lies at 9 deg and pitches to -14), but not while well ahead of
+    the target along its path (the breaststroke dived at full tempo 1-2 m past a diving target)."""
 
     min_tempo: float = 0.5
     keep_pace: bool = True
@@ -133,10 +133,10 @@ class TempoControl:
             return max(tempo, self.turn_tempo)
         return tempo
 
-    def diving_tempo(self, tempo: float, below_m: float, ahead_s: float = 0.0) -> float:
+    def diving_tempo(self, tempo: float, below_m: float, well_ahead: bool = False) -> float:
         """``tempo``, raised to ``dive_tempo`` for a point to swim to ``below_m`` below, unless the
-        swimmer is ``ahead_s`` > 0 s ahead of its target along the path."""
-        if self.dive_tempo is not None and below_m > self.dive_below_m and ahead_s <= 0.0:
+        swimmer is ``well_ahead`` of its target along the path."""
+        if self.dive_tempo is not None and below_m > self.dive_below_m and not well_ahead:
             return max(tempo, self.dive_tempo)
         return tempo
 
@@ -420,7 +420,8 @@ class TargetChooser:
             if foresight:
                 tempo = self.tempo_control.catching_up_tempo(tempo, distance, ahead_of_target_s)
         if not self._levelling:
-            tempo = self.tempo_control.diving_tempo(tempo, float(position[2] - target[2]), ahead_of_target_s)
+            tempo = self.tempo_control.diving_tempo(tempo, float(position[2] - target[2]),
+                                                    well_ahead=ahead_of_target_s > self.lead.wait_ahead_s)
         self._last_error_rad = turn_error(att, position, target, self._last_error_rad)
         yaw = self._yaw_fraction(target) * self._last_error_rad
         near = (distance < self.tempo_control.glide_within_m
