@@ -423,7 +423,8 @@ class TargetChooser:
             tempo = self.tempo_control.diving_tempo(tempo, float(position[2] - target[2]),
                                                     well_ahead=ahead_of_target_s > self.lead.wait_ahead_s)
         self._last_error_rad = turn_error(att, position, target, self._last_error_rad)
-        yaw = self._yaw_fraction(target) * self._last_error_rad
+        under_water = self._under_water(target)    # the yaw share, the pitch level and the sequence go by it
+        yaw = self._yaw_fraction(bool(under_water)) * self._last_error_rad
         near = (distance < self.tempo_control.glide_within_m
                 and (not foresight or ahead_of_target_s > self.lead.glide_ahead_s))
         glide = ((near or (waiting and self.tempo_control.glide_within_m > 0))
@@ -432,17 +433,18 @@ class TargetChooser:
             # Turning slowly, the backstroke stood up or rolled onto its side and stalled there for
             # tens of seconds with every sequence at full weight; a plain cycle at speed rights it
             # (the held offsets wait, as through a glide).
-            return CycleChoice(self._under_water(target), self.level_off_tempo, thrust_demand=drive)
+            return CycleChoice(under_water, self.level_off_tempo, thrust_demand=drive)
         weights = {}        # a glide holds its first pose: no sequence, and the held offsets wait
         if not glide:
-            weights = self.table.weights_for(yaw, tempo) | self._attitude_weights(mean, position, target, tempo)
+            weights = (self.table.weights_for(yaw, tempo)
+                       | self._attitude_weights(mean, position, target, tempo, bool(under_water)))
         if abs(yaw) > self.gains.over_weight_within_rad:
             weights = {name: min(1.0, w) for name, w in weights.items()}
         if self._levelling and self.level_off_sequence:
             weights[LEVEL_OFF] = 1.0
         if self._levelling and self.level_off_pitch_down_weight is not None:
             weights[PITCH_DOWN] = self.level_off_pitch_down_weight
-        weights |= self._under_water(target)
+        weights |= under_water
         # Near the target, or turning hard, the rules stop seeking more thrust (Yang 4.4: more force
         # only where more is wanted); else they speed the swimmer past a slow target.
         return CycleChoice(weights, tempo, glide, self.tempo_control.glide_cycles if glide else 1.0,
@@ -455,12 +457,12 @@ class TargetChooser:
             (pitch_rad is not None and last_cycle.pitch_rad > pitch_rad)
             or (roll_rad is not None and abs(last_cycle.roll_rad) > roll_rad))
 
-    def _yaw_fraction(self, aim_m: np.ndarray) -> float:
+    def _yaw_fraction(self, under_water: bool) -> float:
         """The share of the heading error corrected this cycle. Under water a yaw weight turns the
         breaststroke 1.5-2 times as far as the surface's table says, and correcting 75 % of the
         error a cycle there swung its heading +-60 deg every ~9 s, and each hard turn rolled it
         and moved its depth."""
-        if self.under_water_yaw_fraction is not None and self._under_water(aim_m):
+        if self.under_water_yaw_fraction is not None and under_water:
             return self.under_water_yaw_fraction
         return self.gains.yaw_fraction
 
@@ -481,12 +483,12 @@ class TargetChooser:
         return np.array([velocity[0], velocity[1], 0.0])
 
     def _attitude_weights(self, mean: MeanAttitude, position_m: np.ndarray, target_m: np.ndarray,
-                          tempo: float) -> dict[str, float]:
+                          tempo: float, under_water: bool) -> dict[str, float]:
         """The pitch and roll sequences' weights: each axis's held offset moved by its fraction of
         the error, plus the proportional share of it (levelling off, the level-off sequence does
         the pitching)."""
         level = MeanAttitude(self.table.pace.pitch_at(tempo), self.table.pace.roll_at(tempo))
-        if self.under_water_level_pitch_rad is not None and self._under_water(target_m):
+        if self.under_water_level_pitch_rad is not None and under_water:
             # The surface's pitch at a slow tempo is nose-up (+21 deg at 0.7): under water that climbs.
             level = MeanAttitude(self.under_water_level_pitch_rad, level.roll_rad)
         errors = attitude_errors(mean, position_m, target_m, self.posture, level, self.gains)
