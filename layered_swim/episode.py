@@ -233,7 +233,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
             pace, lead, pitch_roll = tempo_control, Lead(), (0.0, 0.0)
             if not goal_line:
                 pitch_roll = (steer.pitch_fraction, steer.roll_fraction)
-                pace = TempoControl(min_tempo=steer.min_tempo, glide_within_m=steer.glide_within_m,
+                pace = TempoControl(min_tempo=steer.min_tempo, far_m=steer.full_tempo_beyond_m,
+                                    glide_within_m=steer.glide_within_m,
                                     glide_cycles=steer.glide_cycles, turn_tempo=steer.turn_tempo,
                                     turn_tempo_until_ahead_s=steer.turn_tempo_until_ahead_s,
                                     wide_turn_rad=math.radians(steer.wide_turn_deg),

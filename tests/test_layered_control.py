@@ -293,6 +293,20 @@ def test_turning_toward_a_target_off_the_heading_swims_at_the_turn_tempo():
     assert ahead.tempo == pytest.approx(1.0)
 
 
+def test_full_tempo_from_far_m_and_in_proportion_nearer():
+    """Full tempo from far_m off the target, the slowest within near_m, in proportion between (a
+    stroke far faster than its target, the backstroke, takes far_m 1.5 m rather than 0.6)."""
+    wide = TempoControl(min_tempo=0.5, far_m=1.5)
+    assert wide.drive(0.1) == 0.0 and wide.drive(1.5) == wide.drive(3.0) == 1.0
+    assert wide.tempo_for(wide.drive(0.85)) == pytest.approx(0.5 + 0.5 * (0.85 - 0.2) / 1.3)
+    assert TempoControl().drive(0.6) == 1.0 > wide.drive(0.6)
+    state = still_state(np.full(16, 1 / 16))          # at the origin, heading +x
+    near = FixedTarget((1.0, 0.0, 0.0))
+    assert TargetChooser(near, table(), "prone")(0, state, None).tempo == pytest.approx(1.0)
+    assert TargetChooser(near, table(), "prone", tempo=wide)(0, state, None).tempo == pytest.approx(
+        0.5 + 0.5 * 0.8 / 1.3)
+
+
 def test_far_behind_a_moving_target_swims_at_the_turn_tempo():
     """Behind a target moving along a known path and more than catch_up_beyond_m from it, a stroke
     swims at its turn tempo; nearer, ahead of it, or with a target whose path is unknown (a jump),
@@ -368,6 +382,10 @@ def test_steering_settings_come_from_the_stroke_file_and_leave_its_calibration_f
     pace = crawl.controller.chooser.tempo_control
     assert (pace.min_tempo, pace.glide_cycles, pace.turn_tempo, pace.turn_tempo_until_ahead_s) == (
         steering.min_tempo, steering.glide_cycles, steering.turn_tempo, steering.turn_tempo_until_ahead_s)
+    assert pace.far_m == steering.full_tempo_beyond_m == TempoControl().far_m
+    back = Episode("backstroke", FollowTarget(FixedTarget([5.0, 0.0, -0.3])))
+    back.close()
+    assert back.controller.chooser.tempo_control.far_m == back.stroke.steering.full_tempo_beyond_m > pace.far_m
     lead = crawl.controller.chooser.lead
     assert (lead.bend_s, lead.wait_ahead_s) == (steering.lead_bend_s, steering.wait_ahead_s) != (
         Lead().bend_s, Lead().wait_ahead_s)

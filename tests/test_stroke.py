@@ -96,6 +96,7 @@ def test_shipped_strokes_load(name):
     (GOOD + "steering: {under_water_yaw_fraction: 0.4}\n", ["steering.under_water_yaw_fraction",
                                                           "under_water_below_m"]),
     (GOOD + "steering: {under_water_yaw_fraction: 1.5}\n", ["steering.under_water_yaw_fraction"]),
+    (GOOD + "steering: {full_tempo_beyond_m: 0.1}\n", ["steering.full_tempo_beyond_m"]),
     (GOOD + "steering: {lead_straight_s: 4}\n", ["steering", "lead_bend_s (3 s) must be at least lead_straight_s"]),
     (GOOD + "steering: {lead_straight_diving_s: 5, lead_bend_s: 4}\n", ["steering", "lead_bend_s (4 s)", "(5 s)"]),
     (GOOD + "trim: {joints: {elbow_l: {flexion: 10}}}\n", ["trim.joints", "elbow_l.flexion", "range"]),

@@ -115,6 +115,10 @@ class SteeringSpec(Strict):
     # Share of a pitch or roll error (beyond that) corrected at once, on top of the held offset.
     attitude_proportional: float = Field(SteeringGains.attitude_proportional, ge=0.0, le=2.0)
     min_tempo: float = Field(0.5, ge=0.1, le=1.0)
+    # Full tempo from this far from the target, the slowest within 0.2 m, in between in proportion:
+    # a stroke much faster at full tempo than the paths' 0.5 m/s (the backstroke, 1.37 m/s) ran past
+    # its target and waited, over and over, when it swam flat out from 0.6 m off.
+    full_tempo_beyond_m: float = Field(0.6, gt=0.2, le=20.0)     # TempoControl.far_m, beyond its near_m
     glide_within_m: float = Field(0.0, ge=0.0, le=10.0)
     glide_cycles: float = Field(1.0, gt=0.0, le=1.0)     # a glide's length in cycles
     # At least this tempo while turning more than 30 deg toward a target, unless more than
