@@ -295,7 +295,7 @@ def test_turning_toward_a_target_off_the_heading_swims_at_the_turn_tempo():
 
 def test_full_tempo_from_far_m_and_in_proportion_nearer():
     """Full tempo from far_m off the target, the slowest within near_m, in proportion between (a
-    stroke far faster than its target, the backstroke, takes far_m 1.5 m rather than 0.6)."""
+    stroke far faster than its target, the backstroke, swims flat out only from farther off)."""
     wide = TempoControl(min_tempo=0.5, far_m=1.5)
     assert wide.drive(0.1) == 0.0 and wide.drive(1.5) == wide.drive(3.0) == 1.0
     assert wide.tempo_for(wide.drive(0.85)) == pytest.approx(0.5 + 0.5 * (0.85 - 0.2) / 1.3)
