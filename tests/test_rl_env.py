@@ -33,9 +33,10 @@ def test_gymnasium_env_checker_passes():
     e.close()
 
 
-def test_stable_baselines3_ppo_trains_on_it_unmodified():
+def test_stable_baselines3_ppo_trains_on_it_unmodified(tmp_path, monkeypatch):
     from stable_baselines3 import PPO
 
+    monkeypatch.setenv("SB3_LOGDIR", str(tmp_path))    # its logger's folder, else a new one in /tmp each run
     e = gym.make("layered_swim/BreaststrokeGoal-v0", env_state="TotalFT")
     model = PPO("MlpPolicy", e, n_steps=256, batch_size=64, n_epochs=1, seed=0, device="cpu")
     model.learn(total_timesteps=1024)

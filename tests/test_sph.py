@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -116,12 +117,14 @@ def test_box_mesh_is_closed_with_outward_faces():
 
 def test_a_failing_request_is_one_error_and_a_dead_worker_too():
     worker = SphWorker(1)
+    scratch = [Path(worker._folder.name), worker.log_path]
     with pytest.raises(FluidError, match="unknown request 'nonsense'"):
         worker.request("nonsense")
     worker._process.kill()
     with pytest.raises(FluidError, match="process died during 'particles'"):
         worker.request("particles")
     worker.close()
+    assert not any(path.exists() for path in scratch)      # a killed worker's scene folder and log go too
 
 
 def test_held_box_buoyancy_is_rho_g_v_within_30_percent():

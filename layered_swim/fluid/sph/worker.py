@@ -24,13 +24,12 @@ REPLY_TIMEOUT_S = 600.0     # no single request (scene build, settle, step) take
 FILL_EXCESS = 0.25          # the block is filled this share of the depth above the surface
 
 
-def _serve(conn) -> None:
-    """The worker's loop: build a scene, then answer steps until told to stop."""
+def _serve(conn, folder: Path) -> None:
+    """The worker's loop: build a scene in ``folder``, then answer steps until told to stop."""
     from layered_swim.fluid.sph.scene import write_scene
     from layered_swim.fluid.sph.solver import INSIDE_MARGIN_RADII, SphSolver
 
     solver = walls = None
-    folder = tempfile.TemporaryDirectory(prefix="layered_swim_sph_")
     while True:
         try:
             command, payload = conn.recv()
@@ -38,7 +37,7 @@ def _serve(conn) -> None:
             break
         try:
             if command == "start":
-                solver, reply = _start(payload, Path(folder.name), write_scene, SphSolver, INSIDE_MARGIN_RADII)
+                solver, reply = _start(payload, folder, write_scene, SphSolver, INSIDE_MARGIN_RADII)
                 scene = payload["scene"]
                 margin = 2 * scene["particle_radius_m"]
                 walls = (np.asarray(scene["pool_min_m"]) - margin, np.asarray(scene["pool_max_m"]) + margin)
@@ -58,7 +57,6 @@ def _serve(conn) -> None:
         except Exception as err:   # noqa: BLE001  every failure goes back as one line
             last = traceback.extract_tb(err.__traceback__)[-1]
             conn.send(("error", f"{type(err).__name__}: {err} (at {Path(last.filename).name}:{last.lineno})"))
-    folder.cleanup()
 
 
 def _max_speed(solver) -> float:
@@ -128,15 +126,17 @@ class SphWorker:
 
     The worker is a fresh interpreter (``python -m``) on one end of a socket pair: no fork of a
     process that holds PyBullet, and no re-import of the caller's script. The library's console
-    chatter goes to a log file, never into the caller's stdout (``--json``)."""
+    chatter goes to a log file, never into the caller's stdout (``--json``). The scene's folder is the
+    caller's too, so that a worker that dies (or is killed) leaves nothing behind."""
 
     def __init__(self, threads: int):
         ours, theirs = socket.socketpair()
+        self._folder = tempfile.TemporaryDirectory(prefix="layered_swim_sph_")
         self.log_path = Path(tempfile.mkstemp(prefix="layered_swim_sph_", suffix=".log")[1])
         env = {**os.environ, "OMP_NUM_THREADS": str(threads)}    # OpenMP reads it when it loads
         with theirs, open(self.log_path, "wb") as log:
             self._process = subprocess.Popen(
-                [sys.executable, "-m", "layered_swim.fluid.sph.worker", str(theirs.fileno())],
+                [sys.executable, "-m", "layered_swim.fluid.sph.worker", str(theirs.fileno()), self._folder.name],
                 pass_fds=(theirs.fileno(),), stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
                 env=env)
         self._conn = Connection(ours.detach())
@@ -174,7 +174,8 @@ class SphWorker:
             self._process = None
         self._conn.close()
         self.log_path.unlink(missing_ok=True)
+        self._folder.cleanup()
 
 
 if __name__ == "__main__":
-    _serve(Connection(int(sys.argv[1])))
+    _serve(Connection(int(sys.argv[1])), Path(sys.argv[2]))
