@@ -386,6 +386,9 @@ def test_steering_settings_come_from_the_stroke_file_and_leave_its_calibration_f
     back = Episode("backstroke", FollowTarget(FixedTarget([5.0, 0.0, -0.3])))
     back.close()
     assert back.controller.chooser.tempo_control.far_m == back.stroke.steering.full_tempo_beyond_m > pace.far_m
+    breast = Episode("breaststroke", FollowTarget(FixedTarget([5.0, 0.0, -0.3])))
+    breast.close()       # its pitch is left alone within 5 deg (it swung pitch_up to pitch_down each cycle)
+    assert breast.controller.chooser.gains.attitude_within_rad == pytest.approx(math.radians(5.0))
     lead = crawl.controller.chooser.lead
     assert (lead.bend_s, lead.wait_ahead_s) == (steering.lead_bend_s, steering.wait_ahead_s) != (
         Lead().bend_s, Lead().wait_ahead_s)
