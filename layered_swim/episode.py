@@ -239,7 +239,8 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                     turn_tempo_until_ahead_s=steer.turn_tempo_until_ahead_s,
                                     wide_turn_rad=math.radians(steer.wide_turn_deg),
                                     catch_up_beyond_m=steer.catch_up_beyond_m, dive_tempo=steer.dive_tempo,
-                                    close_gap_s=steer.close_gap_s, wait_turn_tempo=steer.wait_turn_tempo,
+                                    close_gap_s=steer.close_gap_s, close_gap_beyond_m=steer.close_gap_beyond_m,
+                                    wait_turn_tempo=steer.wait_turn_tempo,
                                     wait_pace=steer.wait_pace)
                 lead = Lead(straight_s=steer.lead_straight_s, bend_s=steer.lead_bend_s,
                             diving_straight_s=steer.lead_straight_diving_s, wait_ahead_s=steer.wait_ahead_s,

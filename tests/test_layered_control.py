@@ -326,12 +326,16 @@ def test_far_behind_a_moving_target_swims_at_the_turn_tempo():
 
 def test_behind_a_moving_target_at_the_surface_a_stroke_closes_the_gap():
     """With close_gap_s, a stroke behind a moving target swims at its pace plus the gap over
-    close_gap_s (the test table's pace: 0.4 m/s at tempo 0.5, 0.8 at 1.0), up to its turn tempo;
-    ahead of it, at its pace; without, at its pace alone; and not where the path dives."""
+    close_gap_s (the test table's pace: 0.4 m/s at tempo 0.5, 0.8 at 1.0), up to its turn tempo,
+    or only the gap beyond close_gap_beyond_m; ahead of it, at its pace; without, at its pace
+    alone; and not where the path dives."""
     closing = TempoControl(close_gap_s=0.5)
     assert closing.closing_speed_m_s(0.5, 0.1) == pytest.approx(0.7)
     assert closing.closing_speed_m_s(0.5, -0.3) == pytest.approx(0.5)
     assert TempoControl().closing_speed_m_s(0.5, 0.1) == pytest.approx(0.5)
+    beyond = TempoControl(close_gap_s=0.5, close_gap_beyond_m=1.0)     # only the gap beyond 1 m
+    assert beyond.closing_speed_m_s(0.5, 0.8) == pytest.approx(0.5)
+    assert beyond.closing_speed_m_s(0.5, 1.3) == pytest.approx(1.1)
     along_x = TrajectoryTarget(np.array([[0.1, 0.0, 0.0], [30.1, 0.0, 0.0]]), np.array([0.0, 60.0]), 1.0, False)
     assert behind_along_m(along_x, 0.0, np.zeros(3)) == pytest.approx(0.1)
     assert behind_along_m(along_x, 0.0, np.array([5.1, 2.0, -1.0])) == pytest.approx(-5.0)

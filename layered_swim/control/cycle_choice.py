@@ -60,7 +60,10 @@ class TempoControl:
     ``close_gap_s``: behind a moving target along its way, swim at its pace plus the gap over this
     many seconds (up to ``turn_tempo``, the stroke's fastest), not its pace alone: tempo by distance
     alone left the breaststroke trailing its target by 0.45 m on a straight line (steering costs it
-    speed that the calibration's pace does not know of), and a current against it further.
+    speed that the calibration's pace does not know of), and a current against it further. Only
+    the gap beyond ``close_gap_beyond_m``: the crawl, fast and gliding to wait, closed every few
+    tenths of a metre at once in still water, overshot and waited, and followed the figure-eight
+    further off.
 
     ``wait_turn_tempo``: waiting for a moving target, at least this tempo while it is more than
     ``easy_turn_rad`` off the heading (None: the slowest): the backstroke's slowest tempo (0.55)
@@ -91,15 +94,17 @@ class TempoControl:
     dive_tempo: float | None = None
     dive_below_m: float = 0.3
     close_gap_s: float | None = None
+    close_gap_beyond_m: float = 0.0
     wait_turn_tempo: float | None = None
     wait_pace: float | None = None
 
     def closing_speed_m_s(self, pace_m_s: float, behind_m: float) -> float:
         """The speed to swim at behind a target moving at ``pace_m_s`` by ``behind_m`` along its
-        way: its pace, plus the gap closed over ``close_gap_s`` (its pace alone with none)."""
+        way: its pace, plus the gap beyond ``close_gap_beyond_m`` closed over ``close_gap_s`` (its
+        pace alone with none)."""
         if self.close_gap_s is None:
             return pace_m_s
-        return pace_m_s + max(0.0, behind_m) / self.close_gap_s
+        return pace_m_s + max(0.0, behind_m - self.close_gap_beyond_m) / self.close_gap_s
 
     def drive(self, distance_m: float, heading_error_rad: float = 0.0) -> float:
         """How hard to swim, 0 (slowest) to 1 (full tempo)."""

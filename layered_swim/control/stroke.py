@@ -131,6 +131,7 @@ class SteeringSpec(Strict):
     # Behind a moving target at the surface, swim at its pace plus the gap over this many seconds,
     # up to turn_tempo (none: at its pace, faster only by distance).
     close_gap_s: float | None = Field(None, gt=0.0, le=60.0)
+    close_gap_beyond_m: float = Field(0.0, ge=0.0, le=20.0)     # ... only the gap beyond this
     # At least this tempo while the point steered for lies more than 0.3 m below (none: any): a
     # stroke that lies nose-up when slow cannot pitch down far enough to dive at its pace.
     dive_tempo: float | None = Field(None, ge=0.5, le=1.5)
