@@ -241,11 +241,13 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                     catch_up_beyond_m=steer.catch_up_beyond_m, dive_tempo=steer.dive_tempo,
                                     close_gap_s=steer.close_gap_s, close_gap_beyond_m=steer.close_gap_beyond_m,
                                     wait_turn_tempo=steer.wait_turn_tempo,
-                                    wait_pace=steer.wait_pace)
+                                    wait_pace=steer.wait_pace, weave_tempo=steer.weave_tempo)
                 lead = Lead(straight_s=steer.lead_straight_s, bend_s=steer.lead_bend_s,
                             diving_straight_s=steer.lead_straight_diving_s, wait_ahead_s=steer.wait_ahead_s,
                             wait_within_m=steer.wait_within_m, wait_depth_within_m=steer.wait_depth_within_m,
-                            aim_off=steer.aim_off)
+                            aim_off=steer.aim_off,
+                            weave_rad=None if steer.weave_deg is None else math.radians(steer.weave_deg),
+                            weave_within_m=steer.weave_within_m)
             gains = SteeringGains(steer.yaw_fraction, *pitch_roll,
                                   over_weight_within_rad=math.radians(steer.over_weight_within_deg),
                                   depth_within_m=steer.depth_within_m,

@@ -18,6 +18,7 @@ from layered_swim.control.cycle_choice import (
     TempoControl,
     behind_along_m,
     stays_at_surface,
+    weave_aim,
 )
 from layered_swim.control.layered import CycleChoice, LayeredController, Layers, fixed_weights
 from layered_swim.control.rules import arm_indices, rule_offsets
@@ -704,6 +705,33 @@ def test_a_swimmer_ahead_of_a_diving_target_but_above_it_dives_on_instead_of_wai
     assert TargetChooser(deep, table(), "prone")(0, state, None).thrust_demand == 0.0
     diving = TargetChooser(deep, table(), "prone", lead=Lead(wait_depth_within_m=0.5))(0, state, None)
     assert diving.thrust_demand > 0.0 and diving.tempo > TempoControl().min_tempo
+
+
+def test_waiting_on_a_straight_stretch_a_stroke_with_a_weave_weaves_across_the_path():
+    """``weave_aim`` moves the aim across a straight path so the swimmer heads ``angle`` off it, and
+    turns to the other side once the swimmer is more than ``within_m`` out; the chooser weaves only
+    while waiting where the path runs straight, at ``weave_tempo`` at least (the backstroke, faster
+    at its slowest tempo than a 0.5 m/s target, ran ahead of it on straight stretches)."""
+    aim, place, along = np.array([2.0, 0.0, -0.3]), np.zeros(3), np.array([1.0, 0.0])    # a path along +x
+    moved, side = weave_aim(aim, np.zeros(3), place, along, 1.0, math.radians(45.0), 0.6)
+    assert side == 1.0 and moved == pytest.approx([2.0, 2.0, -0.3])         # 2 m ahead, tan 45 deg * 2 m left
+    _, side = weave_aim(aim, np.array([0.0, 0.5, 0.0]), place, along, 1.0, math.radians(45.0), 0.6)
+    assert side == 1.0                                                         # 0.5 m out: on to the left
+    moved, side = weave_aim(aim, np.array([0.0, 0.7, 0.0]), place, along, 1.0, math.radians(45.0), 0.6)
+    assert side == -1.0 and moved == pytest.approx([2.0, -math.hypot(2.0, 0.7), -0.3])   # 0.7 m out: back right
+    line = TrajectoryTarget(np.array([[-2.0, 0.0, 0.0], [20.0, 0.0, 0.0]]), np.array([0.0, 22.0]), 0.5, False)
+    angles = np.linspace(0.0, 2.0 * math.pi, 73)
+    ring = np.stack([2.0 * np.sin(angles), 2.0 - 2.0 * np.cos(angles), np.zeros_like(angles)], axis=1)
+    circle = TrajectoryTarget(ring, 2.0 * angles, 0.5, True)     # radius 2 m at 0.5 m/s: 43 deg over 3 s
+    weave = Lead(weave_rad=math.radians(55.0))
+    assert weave.weaves(line, 4.0) and not weave.weaves(circle, 4.0) and not Lead().weaves(line, 4.0)
+    state = still_state(np.full(16, 1 / 16))          # at the origin heading +x, 2 m (4 s) ahead of the target
+    slow = TempoControl(min_tempo=0.55, weave_tempo=0.7)
+    weaving = TargetChooser(line, table(), "prone", tempo=slow, lead=weave)(0, state, None)
+    assert weaving.thrust_demand == 0.0 and weaving.tempo == pytest.approx(0.7)
+    assert weaving.weights.get("yaw_left", 0.0) > 0.0 and "yaw_right" not in weaving.weights
+    straight = TargetChooser(line, table(), "prone", tempo=slow)(0, state, None)
+    assert straight.tempo == pytest.approx(0.55) and not straight.weights.get("yaw_left", 0.0)
 
 
 def test_drift_is_the_sideways_motion_over_a_cycle_and_a_steady_turn_has_none():

@@ -96,6 +96,7 @@ class TempoControl:
     close_gap_beyond_m: float = 0.0
     wait_turn_tempo: float | None = None
     wait_pace: float | None = None
+    weave_tempo: float | None = None
 
     def closing_speed_m_s(self, pace_m_s: float, behind_m: float) -> float:
         """The speed to swim at behind a target moving at ``pace_m_s`` by ``behind_m`` along its
@@ -120,14 +121,17 @@ class TempoControl:
             return max(tempo, self.turn_tempo)
         return tempo
 
-    def waiting_tempo(self, tempo: float, heading_error_rad: float, pace_tempo: float | None = None) -> float:
-        """``tempo`` while waiting, raised to ``wait_turn_tempo`` for a turn wider than ``easy_turn_rad``
-        and, with ``wait_pace``, to ``pace_tempo``: the tempo whose steady speed is that share of the
-        target's pace."""
+    def waiting_tempo(self, tempo: float, heading_error_rad: float, pace_tempo: float | None = None,
+                      weaving: bool = False) -> float:
+        """``tempo`` while waiting, raised to ``wait_turn_tempo`` for a turn wider than ``easy_turn_rad``,
+        with ``wait_pace`` to ``pace_tempo`` (the tempo whose steady speed is that share of the
+        target's pace), and ``weaving`` to ``weave_tempo``."""
         if self.wait_turn_tempo is not None and abs(heading_error_rad) > self.easy_turn_rad:
             tempo = max(tempo, self.wait_turn_tempo)
         if self.wait_pace is not None and pace_tempo is not None:
             tempo = max(tempo, pace_tempo)
+        if weaving and self.weave_tempo is not None:
+            tempo = max(tempo, self.weave_tempo)
         return tempo
 
     def catching_up_tempo(self, tempo: float, distance_m: float, ahead_of_target_s: float) -> float:
@@ -146,6 +150,7 @@ class TempoControl:
 
 
 STEP_S = 0.5    # the target's direction and speed are read from its move over this long
+WEAVE_STRAIGHT_RAD = math.radians(20.0)     # a path turning less than this over a lead's bend_s runs straight
 
 
 class Water(Protocol):
@@ -175,6 +180,28 @@ class InWater:
 
 def _step_m(target: Target, time_s: float) -> np.ndarray:
     return target.position(time_s + STEP_S) - target.position(time_s)
+
+
+def bend_rad(target: Target, time_s: float, over_s: float) -> float:
+    """How far the target's direction of travel turns from ``time_s`` to ``over_s`` later."""
+    now, later = _step_m(target, time_s), _step_m(target, time_s + over_s)
+    norms = float(np.linalg.norm(now) * np.linalg.norm(later))
+    return math.acos(max(-1.0, min(1.0, float(now @ later) / norms))) if norms > 1e-12 else 0.0
+
+
+def weave_aim(aim_m: np.ndarray, position_m: np.ndarray, place_m: np.ndarray, direction: np.ndarray,
+              side: float, angle_rad: float, within_m: float) -> tuple[np.ndarray, float]:
+    """``aim_m`` moved across a straight path (through ``place_m`` along the horizontal unit
+    ``direction``) so that the swimmer heads about ``angle_rad`` off it toward ``side`` (+1: the
+    path's left), and the side: turned back once the swimmer is more than ``within_m`` out on it."""
+    normal = np.array([-direction[1], direction[0]])
+    across_m = float(np.dot(np.asarray(position_m, float)[:2] - np.asarray(place_m, float)[:2], normal))
+    if side * across_m > within_m:
+        side = -side
+    reach_m = float(np.linalg.norm(np.asarray(aim_m, float)[:2] - np.asarray(position_m, float)[:2]))
+    moved = np.array(aim_m, dtype=float)
+    moved[:2] += normal * side * reach_m * math.tan(angle_rad)
+    return moved, side
 
 
 def behind_along_m(target: Target, time_s: float, position_m: np.ndarray) -> float:
@@ -230,6 +257,11 @@ class Lead:
     # Steer upstream of the aim by the sideways drift the last cycles measured (``Drift``): a
     # current across the path otherwise holds the swimmer a metre or two downstream of it.
     aim_off: bool = False
+    # Waiting on a straight stretch, head this far off the path, to one side and then the other,
+    # turning back beyond weave_within_m out (None: straight on). A stroke still faster than its
+    # target at its slowest tempo (the backstroke: ~0.7 m/s against 0.5) ran 1-3 m ahead of it.
+    weave_rad: float | None = None
+    weave_within_m: float = 0.6
 
     def place_on_path_s(self, target: Target, time_s: float, position_m: np.ndarray) -> tuple[float, float]:
         """When the target passes (or passed) nearest the swimmer, within ``search_s`` of now:
@@ -266,10 +298,14 @@ class Lead:
         """How far ahead to aim: ``straight_s`` (diving: ``diving_straight_s``) where the path runs
         straight, up to ``bend_s`` where it bends by ``full_bend_rad`` or more."""
         straight_s = self.diving_straight_s if diving and self.diving_straight_s is not None else self.straight_s
-        now, later = _step_m(target, time_s), _step_m(target, time_s + self.bend_s)
-        norms = float(np.linalg.norm(now) * np.linalg.norm(later))
-        bend = math.acos(max(-1.0, min(1.0, float(now @ later) / norms))) if norms > 1e-12 else 0.0
+        bend = bend_rad(target, time_s, self.bend_s)
         return straight_s + (self.bend_s - straight_s) * min(1.0, bend / self.full_bend_rad)
+
+    def weaves(self, target: Target, place_s: float) -> bool:
+        """Whether a waiting swimmer at ``place_s`` along the path weaves: the stroke does, and the
+        path runs straight there (it turns less than ``WEAVE_STRAIGHT_RAD`` over ``bend_s``)."""
+        return (self.weave_rad is not None and float(np.linalg.norm(_step_m(target, place_s)[:2])) > 1e-9
+                and bend_rad(target, place_s, self.bend_s) < WEAVE_STRAIGHT_RAD)
 
 
 class Drift:
@@ -362,6 +398,7 @@ class TargetChooser:
         self._last_error_rad = 0.0      # the last cycle's heading error, as steered
         self.held_rad = {"pitch": 0.0, "roll": 0.0}     # the attitude offsets the sequences hold
         self.drift = Drift()
+        self._weave_side = 1.0          # the side of the path a waiting swimmer weaves to (+1: its left)
 
     def __call__(self, cycle: int, state: BodyState, last_cycle: MeanAttitude | None) -> CycleChoice:
         position = state.com_m
@@ -375,6 +412,19 @@ class TargetChooser:
             target, ahead_of_target_s, off_path_m = self.lead.aim(path, state.time_s, position, not at_surface)
         else:
             target, ahead_of_target_s, off_path_m = self.target.position(state.time_s), 0.0, 0.0
+        # Ahead of the target along its path: wait for it at the slowest tempo (turning at full tempo
+        # instead carried the breaststroke further out of the figure-eight), gliding where the stroke
+        # glides to wait (gliding, the breaststroke's depth drifted 0.27 m off a diving target's);
+        # far off the path it swims back instead.
+        waiting = foresight and self.lead.waits(ahead_of_target_s, off_path_m, abs(float(target[2] - position[2])))
+        place_s = state.time_s + ahead_of_target_s
+        weaving = waiting and self.lead.weaves(path, place_s)
+        if cycle == 0:
+            self._weave_side = 1.0
+        if weaving:
+            step = _step_m(path, place_s)[:2]
+            target, self._weave_side = weave_aim(target, position, path.position(place_s), step / np.linalg.norm(step),
+                                                 self._weave_side, self.lead.weave_rad, self.lead.weave_within_m)
         # Heading and pitch as the cycle starts (the same phase every cycle, and current); pitch and
         # roll to steer averaged over the last cycle.
         att = attitude_of(state, self.posture, facing=cycle == 0)     # a spell may start standing up
@@ -398,11 +448,6 @@ class TargetChooser:
         pitch_rad = att.pitch_rad if cycle == 0 or last_cycle is None else max(att.pitch_rad, last_cycle.pitch_rad)
         self._levelling = (cycle == 0 or self._levelling) and self.level_off_beyond_rad is not None and (
             pitch_rad - climb_rad > self.level_off_beyond_rad)
-        # Ahead of the target along its path: wait for it at the slowest tempo (turning at full tempo
-        # instead carried the breaststroke further out of the figure-eight), gliding where the stroke
-        # glides to wait (gliding, the breaststroke's depth drifted 0.27 m off a diving target's);
-        # far off the path it swims back instead.
-        waiting = self.lead.waits(ahead_of_target_s, off_path_m, abs(float(target[2] - position[2])))
         drive = 0.0 if waiting else self.tempo_control.drive(distance, heading_error)
         # Levelling off, kick at the level-off tempo even for a target behind: a fast kick lies it down sooner.
         tempo = self.level_off_tempo if self._levelling else self.tempo_control.tempo_for(drive)
@@ -418,7 +463,7 @@ class TargetChooser:
             pace_tempo = None
             if self.tempo_control.wait_pace is not None:
                 pace_tempo = min(1.0, self.table.pace.tempo_for_speed(self.tempo_control.wait_pace * pace_m_s))
-            tempo = self.tempo_control.waiting_tempo(tempo, heading_error, pace_tempo)
+            tempo = self.tempo_control.waiting_tempo(tempo, heading_error, pace_tempo, weaving)
         else:
             tempo = self.tempo_control.turning_tempo(tempo, heading_error, ahead_of_target_s)
             if foresight:

@@ -155,6 +155,12 @@ class SteeringSpec(Strict):
     # ... and only within this of the depth it steers for (none: at any depth): a stroke that rides
     # up at its slowest tempo (the breaststroke) dives on instead of waiting above a diving path.
     wait_depth_within_m: float | None = Field(None, gt=0.0, le=10.0)
+    # ... and, waiting where the path runs straight, head weave_deg off it, to one side and then the
+    # other, turning back beyond weave_within_m out, at weave_tempo at least (none: straight on at
+    # the slowest tempo): a stroke faster at its slowest tempo than its target (the backstroke) ran ahead.
+    weave_deg: float | None = Field(None, gt=0.0, lt=90.0)
+    weave_within_m: float = Field(0.6, gt=0.0, le=10.0)
+    weave_tempo: float | None = Field(None, ge=0.1, le=1.5)
     # Steer upstream of the aim by the sideways drift measured over the last cycles (a current
     # across the path); the goal task's swims, which the shipped residuals learnt on, never do.
     aim_off: bool = False
