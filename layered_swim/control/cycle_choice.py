@@ -151,6 +151,7 @@ class TempoControl:
 
 STEP_S = 0.5    # the target's direction and speed are read from its move over this long
 WEAVE_STRAIGHT_RAD = math.radians(20.0)     # a path turning less than this over a lead's bend_s runs straight
+WEAVE_STRAIGHT_BENDS = 2
 
 
 class Water(Protocol):
@@ -303,9 +304,12 @@ class Lead:
 
     def weaves(self, target: Target, place_s: float) -> bool:
         """Whether a waiting swimmer at ``place_s`` along the path weaves: the stroke does, and the
-        path runs straight there (it turns less than ``WEAVE_STRAIGHT_RAD`` over ``bend_s``)."""
+        path runs straight there (it turns less than ``WEAVE_STRAIGHT_RAD`` over the next
+        ``WEAVE_STRAIGHT_BENDS`` times ``bend_s``: weaving up to a zigzag's corner, the backstroke
+        stood up in the turn there and stalled for good in 2 of 10 starts)."""
         return (self.weave_rad is not None and float(np.linalg.norm(_step_m(target, place_s)[:2])) > 1e-9
-                and bend_rad(target, place_s, self.bend_s) < WEAVE_STRAIGHT_RAD)
+                and all(bend_rad(target, place_s, k * self.bend_s) < WEAVE_STRAIGHT_RAD
+                        for k in range(1, WEAVE_STRAIGHT_BENDS + 1)))
 
 
 class Drift:
