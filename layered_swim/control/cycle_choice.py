@@ -150,7 +150,9 @@ class TempoControl:
 
 
 STEP_S = 0.5    # the target's direction and speed are read from its move over this long
-WEAVE_STRAIGHT_RAD = math.radians(20.0)     # a path turning less than this over a lead's bend_s runs straight
+# A path runs straight (for weaving) where it turns less than this over a lead's bend_s, and over each
+# multiple of it up to WEAVE_STRAIGHT_BENDS times.
+WEAVE_STRAIGHT_RAD = math.radians(20.0)
 WEAVE_STRAIGHT_BENDS = 2
 
 
