@@ -240,6 +240,7 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
                                     wide_turn_rad=math.radians(steer.wide_turn_deg),
                                     catch_up_beyond_m=steer.catch_up_beyond_m, dive_tempo=steer.dive_tempo,
                                     close_gap_s=steer.close_gap_s, close_gap_beyond_m=steer.close_gap_beyond_m,
+                                    close_gap_ahead_s=steer.close_gap_ahead_s,
                                     wait_turn_tempo=steer.wait_turn_tempo,
                                     wait_pace=steer.wait_pace, weave_tempo=steer.weave_tempo)
                 lead = Lead(straight_s=steer.lead_straight_s, bend_s=steer.lead_bend_s,

@@ -17,6 +17,7 @@ from layered_swim.control.cycle_choice import (
     TargetChooser,
     TempoControl,
     behind_along_m,
+    gain_along_m_s,
     stays_at_surface,
     weave_aim,
 )
@@ -349,6 +350,29 @@ def test_behind_a_moving_target_at_the_surface_a_stroke_closes_the_gap():
     under_a_metre = Medium(surface_z_m=1.0)       # the swimmer and its target 1 m deep
     deep = TargetChooser(along_x, table(), "prone", tempo=closing, water=lambda: under_a_metre)
     assert deep(0, state, None).tempo == pytest.approx(0.625)
+
+
+def test_a_stroke_closes_the_gap_it_will_have_at_the_speed_it_gained_over_its_last_cycle():
+    """With close_gap_ahead_s, the gap closed is the one that far ahead at the speed gained on the
+    target (its speed along the target's way less the target's); the chooser reads that speed
+    off the centre of mass's move since the last cycle's start (none at the first cycle)."""
+    ahead = TempoControl(close_gap_s=0.5, close_gap_ahead_s=2.0)
+    assert ahead.closing_speed_m_s(0.5, 1.0, 0.3) == pytest.approx(0.5 + (1.0 - 0.6) / 0.5)
+    assert ahead.closing_speed_m_s(0.5, 1.0, -0.2) == pytest.approx(0.5 + (1.0 + 0.4) / 0.5)
+    assert ahead.closing_speed_m_s(0.5, 1.0, 0.6) == pytest.approx(0.5)     # it will be ahead: the pace
+    assert TempoControl(close_gap_s=0.5).closing_speed_m_s(0.5, 1.0, 0.3) == pytest.approx(2.5)   # none: as it is
+    along_x = TrajectoryTarget(np.array([[0.1, 0.0, 0.0], [30.1, 0.0, 0.0]]), np.array([0.0, 60.0]), 1.0, False)
+    assert gain_along_m_s(along_x, 0.0, np.array([0.8, 0.3, -1.0])) == pytest.approx(0.3)
+    assert gain_along_m_s(FixedTarget((3.0, 0.0, 0.0)), 0.0, np.array([0.8, 0.0, 0.0])) == 0.0
+    start = still_state(np.full(16, 1 / 16))          # at the origin, 0.1 m behind
+    later = BodyState(1.0, np.tile([0.2, 0.0, 0.0], (16, 1)), start.quat_xyzw, np.zeros((16, 3)),
+                      np.zeros((16, 3)), start.segments)   # 0.2 m on a second later: 0.4 m behind, losing 0.3 m/s
+    for close_gap_ahead_s, tempo in ((0.0, 0.875), (0.5, 0.96875)):
+        # the test table's pace: 0.4 m/s at tempo 0.5, 0.8 at 1.0; 0.5 + 0.4 / 2 or 0.5 + (0.4 + 0.15) / 2 m/s
+        chooser = TargetChooser(along_x, table(), "prone",
+                                tempo=TempoControl(close_gap_s=2.0, close_gap_ahead_s=close_gap_ahead_s))
+        assert chooser(0, start, None).tempo == pytest.approx(0.6875)      # 0.5 + 0.1 / 2 m/s
+        assert chooser(1, later, None).tempo == pytest.approx(tempo)
 
 
 def test_a_gap_is_closed_only_on_a_path_that_stays_at_the_surface():

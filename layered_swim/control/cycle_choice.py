@@ -62,7 +62,11 @@ class TempoControl:
     alone left the breaststroke trailing its target by 0.45 m on a straight line (steering costs it
     speed that the calibration's pace does not know of), and a current against it further. Only
     the gap beyond ``close_gap_beyond_m``: closing every gap, however small, the crawl followed the
-    figure-eight in still water further off (0.74 m against 0.67; beyond 1 m, 0.66).
+    figure-eight in still water further off (0.74 m against 0.67; beyond 1 m, 0.66). The gap
+    closed is the one ``close_gap_ahead_s`` from now at the speed the swimmer gained on the target
+    over its last cycle: its speed follows its tempo a cycle late, and closing the gap as it was,
+    the backstroke swung from 1.3 s behind its target to 1.5 s ahead across the figure-eight's
+    crossing and waited again.
 
     ``wait_turn_tempo``: waiting for a moving target, at least this tempo while it is more than
     ``easy_turn_rad`` off the heading (None: the slowest): the backstroke's slowest tempo (0.55)
@@ -94,17 +98,20 @@ class TempoControl:
     dive_below_m: float = 0.3
     close_gap_s: float | None = None
     close_gap_beyond_m: float = 0.0
+    close_gap_ahead_s: float = 0.0
     wait_turn_tempo: float | None = None
     wait_pace: float | None = None
     weave_tempo: float | None = None
 
-    def closing_speed_m_s(self, pace_m_s: float, behind_m: float) -> float:
+    def closing_speed_m_s(self, pace_m_s: float, behind_m: float, gaining_m_s: float = 0.0) -> float:
         """The speed to swim at behind a target moving at ``pace_m_s`` by ``behind_m`` along its
-        way: its pace, plus the gap beyond ``close_gap_beyond_m`` closed over ``close_gap_s`` (its
-        pace alone with none)."""
+        way, gaining on it at ``gaining_m_s``: its pace, plus the gap beyond ``close_gap_beyond_m``
+        as it will be ``close_gap_ahead_s`` from now, closed over ``close_gap_s`` (its pace alone
+        with none)."""
         if self.close_gap_s is None:
             return pace_m_s
-        return pace_m_s + max(0.0, behind_m - self.close_gap_beyond_m) / self.close_gap_s
+        behind_then_m = behind_m - gaining_m_s * self.close_gap_ahead_s
+        return pace_m_s + max(0.0, behind_then_m - self.close_gap_beyond_m) / self.close_gap_s
 
     def drive(self, distance_m: float, heading_error_rad: float = 0.0) -> float:
         """How hard to swim, 0 (slowest) to 1 (full tempo)."""
@@ -213,6 +220,15 @@ def behind_along_m(target: Target, time_s: float, position_m: np.ndarray) -> flo
     step = _step_m(target, time_s)[:2]
     norm = float(np.linalg.norm(step))
     return float((target.position(time_s) - position_m)[:2] @ step) / norm if norm > 1e-9 else 0.0
+
+
+def gain_along_m_s(target: Target, time_s: float, velocity_m_s: np.ndarray) -> float:
+    """How fast a swimmer moving at ``velocity_m_s`` closes on the target along its way, horizontally:
+    its speed along the target's direction of travel less the target's speed (0 for a target
+    standing still)."""
+    step = _step_m(target, time_s)[:2]
+    norm = float(np.linalg.norm(step))
+    return float(np.asarray(velocity_m_s)[:2] @ step) / norm - norm / STEP_S if norm > 1e-9 else 0.0
 
 
 # Close a gap only on a path that stays at the surface: within this of it now, and no deeper
@@ -405,6 +421,7 @@ class TargetChooser:
         self.held_rad = {"pitch": 0.0, "roll": 0.0}     # the attitude offsets the sequences hold
         self.drift = Drift()
         self._weave_side = 1.0          # the side of the path a waiting swimmer weaves to (+1: its left)
+        self._cycle_start: tuple[float, np.ndarray] | None = None      # the last cycle's start: time, position
 
     def __call__(self, cycle: int, state: BodyState, last_cycle: MeanAttitude | None) -> CycleChoice:
         position = state.com_m
@@ -427,6 +444,8 @@ class TargetChooser:
         weaving = waiting and self.lead.weaves(path, place_s)
         if cycle == 0:
             self._weave_side = 1.0
+            self._cycle_start = None
+        velocity = self._last_cycle_velocity_m_s(state)
         if weaving:
             step = _step_m(path, place_s)[:2]
             target, self._weave_side = weave_aim(target, position, path.position(place_s), step / np.linalg.norm(step),
@@ -462,7 +481,9 @@ class TargetChooser:
         if self.tempo_control.keep_pace and not waiting and foresight:
             tempo = max(tempo, min(1.0, self.table.pace.tempo_for_speed(pace_m_s)))
             if self.tempo_control.close_gap_s is not None and at_surface:
-                closing = self.tempo_control.closing_speed_m_s(pace_m_s, behind_along_m(path, state.time_s, position))
+                gaining = 0.0 if velocity is None else gain_along_m_s(path, state.time_s, velocity - current)
+                closing = self.tempo_control.closing_speed_m_s(pace_m_s, behind_along_m(path, state.time_s, position),
+                                                               gaining)
                 fastest = self.tempo_control.turn_tempo or 1.0
                 tempo = max(tempo, min(fastest, self.table.pace.tempo_for_speed(closing)))
         if waiting:
@@ -504,6 +525,13 @@ class TargetChooser:
         # only where more is wanted); else they speed the swimmer past a slow target.
         return CycleChoice(weights, tempo, glide, self.tempo_control.glide_cycles if glide else 1.0,
                            thrust_demand=drive)
+
+    def _last_cycle_velocity_m_s(self, state: BodyState) -> np.ndarray | None:
+        """The centre of mass's mean velocity over the cycle that ends now (None at the first)."""
+        start, self._cycle_start = self._cycle_start, (state.time_s, state.com_m.copy())
+        if start is None or state.time_s <= start[0]:
+            return None
+        return (state.com_m - start[1]) / (state.time_s - start[0])
 
     def _stood_or_rolled(self, last_cycle: MeanAttitude | None) -> bool:
         """Whether the last cycle's mean attitude was past ``recover_beyond_rad``."""

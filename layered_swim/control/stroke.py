@@ -132,6 +132,9 @@ class SteeringSpec(Strict):
     # up to turn_tempo (none: at its pace, faster only by distance).
     close_gap_s: float | None = Field(None, gt=0.0, le=60.0)
     close_gap_beyond_m: float = Field(0.0, ge=0.0, le=20.0)     # ... only the gap beyond this
+    # ... the gap as it will be this long from now at the speed gained on the target over the last
+    # cycle (0: as it is now)
+    close_gap_ahead_s: float = Field(0.0, ge=0.0, le=10.0)
     # At least this tempo while the point steered for lies more than 0.3 m below (none: any): a
     # stroke that lies nose-up when slow cannot pitch down far enough to dive at its pace.
     dive_tempo: float | None = Field(None, ge=0.5, le=1.5)
