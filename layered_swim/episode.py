@@ -44,7 +44,7 @@ from layered_swim.control.layered import CycleChooser, LayeredController, Layers
 from layered_swim.control.lungs import LungControl
 from layered_swim.control.rules import arm_indices
 from layered_swim.control.steering import SteeringGains
-from layered_swim.control.stroke import LEVEL_OFF, Stroke, StrokeSpec, build_stroke, stroke_path
+from layered_swim.control.stroke import LEVEL_OFF, ROLL_OVER, Stroke, StrokeSpec, build_stroke, stroke_path
 from layered_swim.control.targets import Target
 from layered_swim.fluid import make_fluid
 from layered_swim.fluid.medium import Medium
@@ -261,6 +261,7 @@ def _controller(stroke: Stroke, body, layout, target: Target | None, layers: Lay
             weights = TargetChooser(target, load_table(stroke), stroke.start.posture, gains=gains, tempo=pace,
                                     lead=lead, level_off_beyond_rad=level_off, level_off_tempo=steer.level_off_tempo,
                                     level_off_sequence=LEVEL_OFF in stroke.perturbations,
+                                    roll_over_sequence=ROLL_OVER in stroke.perturbations,
                                     level_off_pitch_down_weight=(None if goal_line
                                                                  else steer.level_off_pitch_down_weight),
                                     recover_beyond_rad=recover, water=None if goal_line else water,

@@ -33,9 +33,11 @@ from layered_swim.control.steering import (
     glide_pitch,
     held_offset,
     turn_error,
+    turned_over,
 )
 from layered_swim.control.stroke import (
     LEVEL_OFF,
+    ROLL_OVER,
     UNDER_WATER,
     JointKeys,
     PerturbationSpec,
@@ -1011,14 +1013,48 @@ def test_the_backstroke_waiting_for_a_slow_target_rights_itself_instead_of_stall
     assert distance[track["track_time_s"] > 60.0].max() < 10.0
 
 
-def test_a_level_off_sequence_leaves_the_calibration_valid():
-    """Calibration swims lying down, where the level-off is never taken: adding one leaves the
-    stroke's calibration hash (and so its table) as it was."""
+@pytest.mark.parametrize("posture, base", [("prone", PRONE_QUAT_XYZW), ("supine", SUPINE_QUAT_XYZW)])
+def test_a_lying_body_rolled_past_its_side_is_turned_over(posture, base):
+    """Rolled about its long axis (the local z) past 90 deg either way its chest faces the other
+    way; within it, not; an upright posture never is."""
+    for roll_deg, over in ((0.0, False), (80.0, False), (-80.0, False), (100.0, True), (-150.0, True), (180.0, True)):
+        half = math.radians(roll_deg) / 2.0
+        rolled = quat_multiply(np.asarray(base, float), np.array([0.0, 0.0, math.sin(half), math.cos(half)]))
+        assert turned_over(rolled, posture) == over, roll_deg
+    assert not turned_over(np.asarray(base, float), "upright")
+
+
+def test_a_turned_over_stroke_with_a_roll_over_sequence_swims_a_cycle_of_it():
+    """Face down, a supine stroke that has a roll_over sequence swims a cycle of it alone at tempo
+    1; one without steers as ever, and so does one lying as it should."""
+    face_down = still_state(np.full(16, 1 / 16))        # prone: a supine stroke's chest faces down
+    target = FixedTarget((5.0, 1.0, 0.0))
+    rolling = TargetChooser(target, table(), "supine", roll_over_sequence=True)(1, face_down, None)
+    assert rolling.weights == {ROLL_OVER: 1.0} and rolling.tempo == 1.0 and not rolling.glide
+    assert ROLL_OVER not in TargetChooser(target, table(), "supine")(1, face_down, None).weights
+    lying_well = TargetChooser(target, table(), "prone", roll_over_sequence=True)(1, face_down, None)
+    assert ROLL_OVER not in lying_well.weights and lying_well.weights["yaw_left"] > 0
+
+
+def test_the_backstroke_that_fell_onto_its_front_rolls_back_and_follows_on():
+    """This start stands up in a turn at 36 s and falls forward, face down; without its roll_over
+    sequence it swam on that way, 2.4-3.6 m off its target by 45-50 s and 11 m by 120 s."""
+    spec = SwimSpec.of("t", stroke="backstroke", task={"kind": "follow", "trajectory": "straight_line"},
+                       seconds=50.0, seed=3, jitter="wide")
+    track = swim(spec.episode(), 50.0).task.track()
+    distance = np.linalg.norm(track["swimmer_m"] - track["target_m"], axis=1)
+    assert distance[track["track_time_s"] > 45.0].max() < 1.5
+
+
+@pytest.mark.parametrize("name", [LEVEL_OFF, ROLL_OVER])
+def test_a_level_off_or_roll_over_sequence_leaves_the_calibration_valid(name):
+    """Calibration swims lying down as it should, where neither the level-off nor the roll-over is
+    taken: adding one leaves the stroke's calibration hash (and so its table) as it was."""
     spec = load(StrokeSpec, stroke_path("front_crawl"))
-    level_off = PerturbationSpec.model_validate({"keys": {"neck": {"flexion": {0.0: 10.0}}}})
-    edited = spec.model_copy(update={"perturbations": {**spec.perturbations, LEVEL_OFF: level_off}})
+    added = PerturbationSpec.model_validate({"keys": {"neck": {"flexion": {0.0: 10.0}}}})
+    edited = spec.model_copy(update={"perturbations": {**spec.perturbations, name: added}})
     assert build_stroke(edited, LAYOUT, "x").spec_sha256 == build_stroke(spec, LAYOUT, "x").spec_sha256
-    assert LEVEL_OFF in build_stroke(edited, LAYOUT, "x").perturbations
+    assert name in build_stroke(edited, LAYOUT, "x").perturbations
 
 
 def test_target_chooser_asks_for_thrust_only_when_far_and_ahead():

@@ -31,8 +31,9 @@ from layered_swim.control.steering import (
     glide_pitch,
     held_offset,
     turn_error,
+    turned_over,
 )
-from layered_swim.control.stroke import LEVEL_OFF, PITCH_DOWN, UNDER_WATER
+from layered_swim.control.stroke import LEVEL_OFF, PITCH_DOWN, ROLL_OVER, UNDER_WATER
 from layered_swim.control.targets import Target, target_speed_m_s
 from layered_swim.state import BodyState
 
@@ -388,6 +389,7 @@ class TargetChooser:
                  gains: SteeringGains = SteeringGains(), tempo: TempoControl = TempoControl(), lead: Lead = Lead(),
                  level_off_beyond_rad: float | None = None, level_off_tempo: float = 1.0,
                  level_off_sequence: bool = True, level_off_pitch_down_weight: float | None = None,
+                 roll_over_sequence: bool = False,
                  recover_beyond_rad: tuple[float | None, float | None] = (None, None),
                  water: Callable[[], Water] | None = None, under_water_below_m: float | None = None,
                  under_water_level_pitch_rad: float | None = None, under_water_yaw_fraction: float | None = None):
@@ -396,6 +398,8 @@ class TargetChooser:
         pitch as a cycle starts nor the last cycle's mean is (None: never), taking the stroke's
         ``level_off`` sequence (``level_off_sequence``: where it has one), or its pitch-down
         sequence at ``level_off_pitch_down_weight``, instead of a pitch correction.
+        ``roll_over_sequence``: turned over (a supine stroke face down), swim a cycle of the
+        stroke's ``roll_over`` sequence alone, at tempo 1 (False: the stroke has none).
         ``recover_beyond_rad``: (pitch, roll); after a cycle whose mean pitch was more than the first
         nose up, or whose mean shoulder roll was more than the second either way, swim a plain
         cycle at ``level_off_tempo`` (None: never).
@@ -412,6 +416,7 @@ class TargetChooser:
         self.level_off_beyond_rad, self.level_off_tempo = level_off_beyond_rad, level_off_tempo
         self.level_off_sequence = level_off_sequence
         self.level_off_pitch_down_weight = level_off_pitch_down_weight
+        self.roll_over_sequence = roll_over_sequence
         self.recover_beyond_rad = recover_beyond_rad
         self.under_water_below_m = under_water_below_m
         self.under_water_level_pitch_rad = under_water_level_pitch_rad
@@ -505,6 +510,10 @@ class TargetChooser:
                 and (not foresight or ahead_of_target_s > self.lead.glide_ahead_s))
         glide = ((near or (waiting and self.tempo_control.glide_within_m > 0))
                  and abs(heading_error) < self.tempo_control.easy_turn_rad)
+        if self.roll_over_sequence and turned_over(state.quat("thorax"), self.posture):
+            # Face down, the backstroke's stroke drove it on at ~0.5 m/s whichever way it faced and
+            # its yaw sequences did not turn it: it stayed so for the rest of a swim, 4-11 m off.
+            return CycleChoice({ROLL_OVER: 1.0}, 1.0)
         if self._stood_or_rolled(last_cycle):
             # Turning slowly, the backstroke stood up or rolled onto its side and stalled there for
             # tens of seconds with every sequence at full weight; a plain cycle at speed rights it

@@ -52,6 +52,12 @@ def shoulder_roll(thorax_quat: np.ndarray) -> float:
     return math.asin(max(-1.0, min(1.0, lateral_z)))
 
 
+def turned_over(thorax_quat: np.ndarray, posture: str) -> bool:
+    """Whether a lying body's chest faces the other way than its posture's (a supine one face
+    down): its shoulder roll (the shoulder line's tilt) reads the same either way."""
+    return lying(posture) and float(quat_rotate(np.asarray(thorax_quat, float), DOWN_LOCAL[posture])[2]) > 0.0
+
+
 def elevation(forward: np.ndarray) -> float:
     """How far a unit axis points up (rad): the forward axis's is the body's pitch (+ nose up)."""
     return math.asin(max(-1.0, min(1.0, float(forward[2]))))

@@ -66,7 +66,10 @@ LEVEL_OFF = "level_off"
 # Under water (the point steered for deeper than ``steering.under_water_below_m``): not calibrated,
 # taken at weight 1 on top of the rest; a stroke that lifts its head to breathe leaves that out.
 UNDER_WATER = "under_water"
-ALL_SEQUENCES = SEQUENCE_NAMES + (LEVEL_OFF, UNDER_WATER)
+# Rolled onto the side it should not face (a supine stroke face down): not calibrated, a cycle of it
+# alone, at tempo 1, in place of all else while the chest faces the other way.
+ROLL_OVER = "roll_over"
+ALL_SEQUENCES = SEQUENCE_NAMES + (LEVEL_OFF, UNDER_WATER, ROLL_OVER)
 Sequence = Literal[ALL_SEQUENCES]
 
 
@@ -504,7 +507,7 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
     # its table, so both stay out; so does the trim, nothing in the water calibration swims in,
     # and the level-off and under-water sequences, which steering takes only at a start standing up
     # or below the surface.
-    exclude = {"steering": True, "rules": True, "trim": True, "perturbations": {LEVEL_OFF, UNDER_WATER}}
+    exclude = {"steering": True, "rules": True, "trim": True, "perturbations": {LEVEL_OFF, UNDER_WATER, ROLL_OVER}}
     digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude=exclude),
                                        sort_keys=True).encode()).hexdigest()
     return Stroke(spec.name, spec.description, spec.period_s, spec.start, basic, perturbations, spec.rules,
