@@ -505,8 +505,8 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
         raise ConfigError(f"{source}: field 'trim.joints': {layout.names[k]} with its trim leaves the range of motion")
     # What calibration measures: it swims without the rules, and the steering settings only read
     # its table, so both stay out; so does the trim, nothing in the water calibration swims in,
-    # and the level-off and under-water sequences, which steering takes only at a start standing up
-    # or below the surface.
+    # and the level-off, under-water and roll-over sequences, which steering takes only at a start
+    # standing up, below the surface or turned over.
     exclude = {"steering": True, "rules": True, "trim": True, "perturbations": {LEVEL_OFF, UNDER_WATER, ROLL_OVER}}
     digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude=exclude),
                                        sort_keys=True).encode()).hexdigest()
