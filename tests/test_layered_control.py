@@ -38,6 +38,7 @@ from layered_swim.control.steering import (
 from layered_swim.control.stroke import (
     LEVEL_OFF,
     ROLL_OVER,
+    UNCALIBRATED_SEQUENCES,
     UNDER_WATER,
     JointKeys,
     PerturbationSpec,
@@ -537,8 +538,8 @@ def test_shipped_calibration_is_fresh_and_every_steering_sequence_acts_monotonic
     stroke = load_stroke(stroke_name, LAYOUT)
     shipped = load_table(stroke)                       # raises if missing or stale
     assert set(shipped.turn_rad) == {"yaw_left", "yaw_right"}
-    uncalibrated = {LEVEL_OFF, UNDER_WATER}
-    assert set(shipped.attitude_rad) == set(stroke.perturbations) - uncalibrated - {"yaw_left", "yaw_right"} == set(
+    assert set(shipped.attitude_rad) == set(stroke.perturbations) - set(UNCALIBRATED_SEQUENCES) - {
+        "yaw_left", "yaw_right"} == set(
         ("pitch_up", "pitch_down", "roll_left", "roll_right"))
     assert shipped.weights[-1] == stroke.steering.max_weight
     for name, rows in shipped.turn_rad.items():

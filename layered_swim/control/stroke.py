@@ -69,7 +69,8 @@ UNDER_WATER = "under_water"
 # Rolled onto the side it should not face (a supine stroke face down): not calibrated, a cycle of it
 # alone, at tempo 1, in place of all else while the chest faces the other way.
 ROLL_OVER = "roll_over"
-ALL_SEQUENCES = SEQUENCE_NAMES + (LEVEL_OFF, UNDER_WATER, ROLL_OVER)
+UNCALIBRATED_SEQUENCES = (LEVEL_OFF, UNDER_WATER, ROLL_OVER)
+ALL_SEQUENCES = SEQUENCE_NAMES + UNCALIBRATED_SEQUENCES
 Sequence = Literal[ALL_SEQUENCES]
 
 
@@ -507,7 +508,7 @@ def build_stroke(spec: StrokeSpec, layout: JointLayout, source: str) -> Stroke:
     # its table, so both stay out; so does the trim, nothing in the water calibration swims in,
     # and the level-off, under-water and roll-over sequences, which steering takes only at a start
     # standing up, below the surface or turned over.
-    exclude = {"steering": True, "rules": True, "trim": True, "perturbations": {LEVEL_OFF, UNDER_WATER, ROLL_OVER}}
+    exclude = {"steering": True, "rules": True, "trim": True, "perturbations": set(UNCALIBRATED_SEQUENCES)}
     digest = hashlib.sha256(json.dumps(spec.model_dump(mode="json", exclude=exclude),
                                        sort_keys=True).encode()).hexdigest()
     return Stroke(spec.name, spec.description, spec.period_s, spec.start, basic, perturbations, spec.rules,
